@@ -1,0 +1,1 @@
+//! mechgen CLI library (placeholder).

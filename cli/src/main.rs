@@ -1,0 +1,2 @@
+//! mechgen CLI (placeholder).
+fn main() {}

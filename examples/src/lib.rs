@@ -1,0 +1,1 @@
+//! Example scenes (placeholder).

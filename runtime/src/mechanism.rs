@@ -1,0 +1,107 @@
+//! The contract between a mechanism's kinematic equations (generated or interpreted) and the solver.
+
+use nalgebra::allocator::Allocator;
+use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector};
+
+/// A column of coordinates or equation values (`Const<N>` for generated scenes: on the stack).
+pub type Vector<D> = OVector<f64, D>;
+/// A square matrix over coordinates × equations, such as the Jacobian Φ_q.
+pub type Matrix<D> = OMatrix<f64, D, D>;
+
+/// Storage bounds every mechanism dimension satisfies; repeat this where-clause on generic code.
+///
+/// `DefaultAllocator: Allocator<D> + Allocator<D, D>` holds for every `Const<N>` and, with the
+/// `alloc` feature, for `Dyn`.
+pub trait Storage<D: Dim>: Allocator<D> + Allocator<D, D> {}
+impl<D: Dim, A: Allocator<D> + Allocator<D, D>> Storage<D> for A {}
+
+/// Error from setting a parameter by name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ParameterError {
+    /// No parameter of that name was declared in the scene.
+    Unknown,
+    /// The value is NaN or infinite.
+    NonFinite,
+}
+
+impl core::fmt::Display for ParameterError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Unknown => f.write_str("no parameter of that name is declared in the scene"),
+            Self::NonFinite => f.write_str("parameter values must be finite"),
+        }
+    }
+}
+
+impl core::error::Error for ParameterError {}
+
+/// The kinematic equations of a planar mechanism in Cartesian body coordinates.
+///
+/// `q` holds `(x, y, θ)` for every body in declaration order; equations follow the scene's
+/// declaration order (ground bodies, joints, drivers). The system is square: `dim()` coordinates and
+/// `dim()` equations. Implementations are straight-line code: they must not allocate or panic.
+pub trait Mechanism
+where
+    DefaultAllocator: Storage<Self::Dim>,
+{
+    /// Type-level number of coordinates (= number of equations).
+    type Dim: Dim;
+
+    /// The number of coordinates (= number of equations), as a value of the type-level dimension.
+    fn dim(&self) -> Self::Dim;
+
+    /// Name of coordinate `index`, such as `"piston.x"`; `None` past the end.
+    fn coordinate_name(&self, index: usize) -> Option<&str>;
+
+    /// Name of equation `index`, such as `"crank_pin.x"`; `None` past the end.
+    fn equation_name(&self, index: usize) -> Option<&str>;
+
+    /// Number of run-time parameters the scene declared.
+    fn parameter_count(&self) -> usize;
+
+    /// Name of parameter `index`; `None` past the end.
+    fn parameter_name(&self, index: usize) -> Option<&str>;
+
+    /// Current value of parameter `index`; `None` past the end.
+    fn parameter(&self, index: usize) -> Option<f64>;
+
+    /// Sets a parameter by name.
+    ///
+    /// # Errors
+    /// [`ParameterError::Unknown`] if no parameter has that name, [`ParameterError::NonFinite`] for
+    /// NaN or infinite values (the mechanism is left unchanged).
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParameterError>;
+
+    /// Writes the scene's initial guess (ground poses and the moving bodies' declared guesses).
+    fn initial_guess(&self, q: &mut Vector<Self::Dim>);
+
+    /// Writes the constraint vector Φ(q, t).
+    fn phi(&self, q: &Vector<Self::Dim>, t: f64, out: &mut Vector<Self::Dim>);
+
+    /// Writes the Jacobian Φ_q(q, t); every entry is overwritten (structural zeros included).
+    fn jacobian(&self, q: &Vector<Self::Dim>, t: f64, out: &mut Matrix<Self::Dim>);
+
+    /// Writes Φ and Φ_q together; generated code overrides this to share sub-expressions.
+    fn phi_and_jacobian(
+        &self,
+        q: &Vector<Self::Dim>,
+        t: f64,
+        phi: &mut Vector<Self::Dim>,
+        jacobian: &mut Matrix<Self::Dim>,
+    ) {
+        self.phi(q, t, phi);
+        self.jacobian(q, t, jacobian);
+    }
+
+    /// Writes the velocity right-hand side ν = −Φ_t, so that Φ_q q̇ = ν.
+    fn nu(&self, q: &Vector<Self::Dim>, t: f64, out: &mut Vector<Self::Dim>);
+
+    /// Writes the acceleration right-hand side γ = −(Φ_q q̇)_q q̇ − 2 Φ_qt q̇ − Φ_tt, so that Φ_q q̈ = γ.
+    fn gamma(
+        &self,
+        q: &Vector<Self::Dim>,
+        qd: &Vector<Self::Dim>,
+        t: f64,
+        out: &mut Vector<Self::Dim>,
+    );
+}
