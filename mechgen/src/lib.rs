@@ -1,4 +1,108 @@
-//! mechgen: placeholder while the generator is written.
+//! mechgen: compiles a declarative planar mechanism into specialised, allocation-free Rust.
+//!
+//! The pipeline runs one way, one module per stage:
+//!
+//! ```text
+//! tokens / .mech ─parse─▶ Spec ─check─▶ Model ─kinematics─▶ Φ, Φ_q, ν, γ (IR) ─emit─▶ Rust tokens
+//!                                                                  └─interpret─▶ numbers
+//! ```
+//!
+//! [`expand`] is that pipeline; the `mechanism!` macro (crate `mechgen-macros`) is a thin
+//! adapter over it, and the `mechgen` CLI runs the same stages on `.mech` files. The grammar is
+//! documented in [`parse`].
+#![deny(missing_docs)]
+
+pub mod check;
+pub mod diff;
+pub mod emit;
+pub mod error;
+pub mod expr;
+pub mod interpret;
+pub mod kinematics;
+pub mod model;
+pub mod parse;
+pub mod spec;
+pub mod stats;
+
 use proc_macro2::TokenStream;
-/// Expands; placeholder.
-pub fn expand_or_errors(t: TokenStream) -> TokenStream { t }
+
+pub use error::Errors;
+pub use kinematics::Kinematics;
+pub use model::Model;
+
+/// A checked model with its derived kinematics: everything needed to emit or interpret a scene.
+#[derive(Clone)]
+pub struct Scene {
+    /// The checked model; its arena also holds the derived expressions.
+    pub model: Model,
+    /// Φ, Φ_q, ν, γ and the initial guess.
+    pub kinematics: Kinematics,
+}
+
+/// Parses, checks and differentiates a spec given as tokens.
+///
+/// # Errors
+/// A syntax error, or every semantic error found, each at its span.
+pub fn compile(tokens: TokenStream) -> Result<Scene, Errors> {
+    let spec = parse::parse_tokens(tokens)?;
+    scene(&spec)
+}
+
+/// Parses, checks and differentiates a spec given as text (the contents of a `.mech` file).
+///
+/// # Errors
+/// As [`compile`].
+pub fn compile_str(source: &str) -> Result<Scene, Errors> {
+    let spec = parse::parse_str(source)?;
+    scene(&spec)
+}
+
+fn scene(spec: &spec::Spec) -> Result<Scene, Errors> {
+    let mut model = check::check(spec)?;
+    let kinematics = kinematics::derive(&mut model);
+    Ok(Scene { model, kinematics })
+}
+
+/// The whole pipeline: spec tokens to generated Rust tokens.
+///
+/// # Errors
+/// As [`compile`].
+pub fn expand(tokens: TokenStream) -> Result<TokenStream, Errors> {
+    let scene = compile(tokens)?;
+    Ok(emit::emit(&scene.model, &scene.kinematics))
+}
+
+/// [`expand`] for the proc macro: errors become `compile_error!`s at their spans, and a panic in
+/// the generator (a bug) is reported as an internal error instead of crashing rustc's macro
+/// expansion.
+pub fn expand_or_errors(tokens: TokenStream) -> TokenStream {
+    let result = std::panic::catch_unwind(move || expand(tokens));
+    match result {
+        Ok(Ok(code)) => code,
+        Ok(Err(errors)) => errors.to_compile_errors(),
+        Err(_) => syn::Error::new(
+            proc_macro2::Span::call_site(),
+            "internal error in mechgen (a bug): please report this scene",
+        )
+        .to_compile_error(),
+    }
+}
+
+/// Generated code for a `.mech` source, formatted for reading (CLI `expand`, snapshots).
+///
+/// # Errors
+/// As [`compile_str`].
+#[cfg(feature = "pretty")]
+pub fn expand_pretty(source: &str) -> Result<String, Errors> {
+    let scene = compile_str(source)?;
+    Ok(pretty(emit::emit(&scene.model, &scene.kinematics)))
+}
+
+/// Formats generated tokens with prettyplease.
+#[cfg(feature = "pretty")]
+pub fn pretty(tokens: TokenStream) -> String {
+    match syn::parse2::<syn::File>(tokens.clone()) {
+        Ok(file) => prettyplease::unparse(&file),
+        Err(_) => tokens.to_string(),
+    }
+}

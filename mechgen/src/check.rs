@@ -1,0 +1,595 @@
+//! Checking: resolve names, lower values to the IR, count degrees of freedom, and report every
+//! problem at the tokens that caused it, with a hint on how to fix it.
+//!
+//! All errors are collected and returned together (serde's `Ctxt` habit), so a user fixing a
+//! scene sees everything at once rather than one error per build.
+
+use std::collections::HashMap;
+
+use proc_macro2::Span;
+use syn::Ident;
+
+use crate::error::Errors;
+use crate::expr::{Arena, Func, Id, Var};
+use crate::model::{Body, Constraint, ConstraintKind, Driven, Model, Param, Point};
+use crate::spec::{BinOp, DriverKind, Expr, ExprKind, JointKind, PointRef, Spec};
+
+/// Checks a spec and builds its model.
+///
+/// # Errors
+/// Every problem found, each at its span: unknown or duplicate names, joints from a body to
+/// itself or between two ground bodies, drivers on ground bodies, zero axes or distances,
+/// `t` outside drivers, unknown functions, and drivers not matching the degrees of freedom.
+pub fn check(spec: &Spec) -> Result<Model, Errors> {
+    let mut cx = Checker {
+        errors: Errors::default(),
+        arena: Arena::new(),
+        bodies: HashMap::new(),
+        params: HashMap::new(),
+        prismatic: HashMap::new(),
+        ground: Vec::new(),
+    };
+    cx.check_names(spec);
+
+    let params: Vec<Param> = spec
+        .params
+        .iter()
+        .map(|p| Param {
+            name: p.name.clone(),
+            docs: p.docs.clone(),
+            default: cx.constant(&p.default),
+        })
+        .collect();
+    cx.ground = spec.bodies.iter().map(|b| b.ground).collect();
+
+    let bodies: Vec<Body> = spec
+        .bodies
+        .iter()
+        .map(|b| Body {
+            name: b.name.clone(),
+            docs: b.docs.clone(),
+            ground: b.ground,
+            pose: [0, 1, 2].map(|k| cx.geometry(&b.pose[k])),
+        })
+        .collect();
+
+    let mut constraints: Vec<Constraint> = bodies
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| b.ground)
+        .map(|(i, b)| Constraint {
+            name: b.name.to_string(),
+            kind: ConstraintKind::Ground {
+                body: i,
+                pose: b.pose,
+            },
+        })
+        .collect();
+    for joint in &spec.joints {
+        if let Some(kind) = cx.joint(&joint.name, joint.kind_span, &joint.kind) {
+            constraints.push(Constraint {
+                name: joint.name.to_string(),
+                kind,
+            });
+        }
+    }
+    for driver in &spec.drivers {
+        let driven = cx.driven(driver.kind_span, &driver.kind);
+        let value = cx.lower(&driver.value, true);
+        if let Some(driven) = driven {
+            constraints.push(Constraint {
+                name: driver.name.to_string(),
+                kind: ConstraintKind::Driver { driven, value },
+            });
+        }
+    }
+    cx.check_mobility(spec);
+    cx.errors.finish()?;
+    Ok(Model {
+        docs: spec.docs.clone(),
+        vis: spec.vis.clone(),
+        name: spec.name.clone(),
+        arena: cx.arena,
+        params,
+        bodies,
+        constraints,
+    })
+}
+
+struct Checker {
+    errors: Errors,
+    arena: Arena,
+    bodies: HashMap<String, usize>,
+    params: HashMap<String, u32>,
+    /// Prismatic joints by name, for `travel` drivers: (a, b, unit axis).
+    prismatic: HashMap<String, (Point, Point, [Id; 2])>,
+    ground: Vec<bool>,
+}
+
+impl Checker {
+    /// Every declared name is unique across parameters, bodies, joints and drivers (they share
+    /// the generated namespace: fields, accessors, equation names); `t` is reserved.
+    fn check_names(&mut self, spec: &Spec) {
+        let mut seen: HashMap<String, &str> = HashMap::new();
+        let names = spec
+            .params
+            .iter()
+            .map(|p| (&p.name, "parameter"))
+            .chain(spec.bodies.iter().map(|b| (&b.name, "body")))
+            .chain(spec.joints.iter().map(|j| (&j.name, "joint")))
+            .chain(spec.drivers.iter().map(|d| (&d.name, "driver")));
+        for (name, what) in names {
+            let key = name.to_string();
+            if key == "t" {
+                self.errors.push(
+                    name.span(),
+                    format!("`t` is time; give this {what} another name"),
+                );
+                continue;
+            }
+            if let Some(first) = seen.get(&key) {
+                self.errors.push(
+                    name.span(),
+                    format!(
+                        "duplicate name `{key}`: a {first} of that name is declared above; \
+                         every parameter, body, joint and driver needs its own name"
+                    ),
+                );
+            } else {
+                seen.insert(key, what);
+            }
+        }
+        for (i, body) in spec.bodies.iter().enumerate() {
+            self.bodies.entry(body.name.to_string()).or_insert(i);
+        }
+        for (i, param) in spec.params.iter().enumerate() {
+            let index = u32::try_from(i).unwrap_or(u32::MAX);
+            self.params.entry(param.name.to_string()).or_insert(index);
+        }
+        if !spec.bodies.iter().any(|b| !b.ground) {
+            self.errors.push(
+                spec.name.span(),
+                "the mechanism has no moving body; declare one with `body NAME near (x, y, angle);`",
+            );
+        }
+    }
+
+    fn body(&mut self, name: &Ident) -> Option<usize> {
+        let found = self.bodies.get(&name.to_string()).copied();
+        if found.is_none() {
+            let known: Vec<String> = {
+                let mut v: Vec<(&String, &usize)> = self.bodies.iter().collect();
+                v.sort_by_key(|(_, i)| **i);
+                v.into_iter().map(|(n, _)| format!("`{n}`")).collect()
+            };
+            self.errors.push(
+                name.span(),
+                format!(
+                    "unknown body `{name}`; declared bodies are {}",
+                    if known.is_empty() {
+                        "none".to_owned()
+                    } else {
+                        known.join(", ")
+                    }
+                ),
+            );
+        }
+        found
+    }
+
+    fn point(&mut self, p: &PointRef) -> Option<Point> {
+        let body = self.body(&p.body)?;
+        let local = match &p.local {
+            Some(xy) => [self.geometry(&xy[0]), self.geometry(&xy[1])],
+            None => [self.arena.zero(), self.arena.zero()],
+        };
+        Some(Point { body, local })
+    }
+
+    fn two_points(&mut self, a: &PointRef, b: &PointRef, span: Span) -> Option<(Point, Point)> {
+        let (pa, pb) = (self.point(a), self.point(b));
+        let (pa, pb) = (pa?, pb?);
+        if pa.body == pb.body {
+            self.errors.push(
+                b.body.span(),
+                format!(
+                    "this joint connects `{}` to itself; join two different bodies",
+                    a.body
+                ),
+            );
+            return None;
+        }
+        if self.ground[pa.body] && self.ground[pb.body] {
+            self.errors.push(
+                span,
+                format!(
+                    "this joint connects two ground bodies (`{}` and `{}`), which cannot move; \
+                     connect at least one moving body",
+                    a.body, b.body
+                ),
+            );
+            return None;
+        }
+        Some((pa, pb))
+    }
+
+    fn joint(&mut self, name: &Ident, span: Span, kind: &JointKind) -> Option<ConstraintKind> {
+        match kind {
+            JointKind::Revolute { a, b } => {
+                let (a, b) = self.two_points(a, b, span)?;
+                Some(ConstraintKind::Revolute { a, b })
+            }
+            JointKind::Prismatic {
+                a,
+                b,
+                axis,
+                axis_span,
+            } => {
+                let points = self.two_points(a, b, span);
+                let ux = self.geometry(&axis[0]);
+                let uy = self.geometry(&axis[1]);
+                let (ux2, uy2) = (self.arena.powi(ux, 2), self.arena.powi(uy, 2));
+                let norm2 = self.arena.add(ux2, uy2);
+                if self.arena.as_const(norm2) == Some(0.0) {
+                    self.errors.push(
+                        *axis_span,
+                        "the axis is the zero vector; give a direction such as `along (1, 0)`",
+                    );
+                    return None;
+                }
+                let norm = self.arena.call(Func::Sqrt, norm2);
+                let axis = [self.arena.div(ux, norm), self.arena.div(uy, norm)];
+                let (a, b) = points?;
+                self.prismatic.insert(name.to_string(), (a, b, axis));
+                Some(ConstraintKind::Prismatic { a, b, axis })
+            }
+            JointKind::Distance { a, b, length } => {
+                let points = self.two_points(a, b, span);
+                let value = self.geometry(length);
+                if self.arena.as_const(value) == Some(0.0) {
+                    self.errors.push(
+                        length.span,
+                        "a distance of zero makes the constraint degenerate (its Jacobian \
+                         vanishes); use `revolute` to make two points coincide",
+                    );
+                    return None;
+                }
+                let (a, b) = points?;
+                Some(ConstraintKind::Distance {
+                    a,
+                    b,
+                    length: value,
+                })
+            }
+        }
+    }
+
+    fn moving(&mut self, name: &Ident, what: &str) -> Option<usize> {
+        let body = self.body(name)?;
+        if self.ground[body] {
+            self.errors.push(
+                name.span(),
+                format!(
+                    "cannot drive {what} of `{name}`: it is a ground body and never moves; \
+                     drive a moving body (declared with `body`)"
+                ),
+            );
+            return None;
+        }
+        Some(body)
+    }
+
+    fn driven(&mut self, span: Span, kind: &DriverKind) -> Option<Driven> {
+        match kind {
+            DriverKind::Angle(body) => Some(Driven::Angle(self.moving(body, "the angle")?)),
+            DriverKind::RelativeAngle(a, b) => {
+                let (ia, ib) = (self.body(a), self.body(b));
+                let (ia, ib) = (ia?, ib?);
+                if ia == ib {
+                    self.errors.push(
+                        b.span(),
+                        format!("relative angle of `{a}` to itself; name two different bodies"),
+                    );
+                    return None;
+                }
+                if self.ground[ia] && self.ground[ib] {
+                    self.errors.push(
+                        span,
+                        "both bodies are ground bodies and never move; drive a moving body",
+                    );
+                    return None;
+                }
+                Some(Driven::RelativeAngle(ia, ib))
+            }
+            DriverKind::X(p) | DriverKind::Y(p) => {
+                self.moving(&p.body, "a point")?;
+                let point = self.point(p)?;
+                Some(if matches!(kind, DriverKind::X(_)) {
+                    Driven::X(point)
+                } else {
+                    Driven::Y(point)
+                })
+            }
+            DriverKind::Travel(joint) => match self.prismatic.get(&joint.to_string()) {
+                Some(&(a, b, axis)) => Some(Driven::Travel { a, b, axis }),
+                None => {
+                    self.errors.push(
+                        joint.span(),
+                        format!(
+                            "`{joint}` is not a prismatic joint declared before this driver; \
+                             `travel` drives the slider of a `prismatic` joint"
+                        ),
+                    );
+                    None
+                }
+            },
+        }
+    }
+
+    /// Gruebler count: each moving body has 3 coordinates, each joint removes its equations
+    /// (ground bodies bring 3 coordinates and 3 equations, which cancel); drivers must take up
+    /// exactly the rest so that the system is square.
+    fn check_mobility(&mut self, spec: &Spec) {
+        let moving = spec.bodies.iter().filter(|b| !b.ground).count();
+        let joint_equations: usize = spec
+            .joints
+            .iter()
+            .map(|j| match j.kind {
+                JointKind::Revolute { .. } | JointKind::Prismatic { .. } => 2,
+                JointKind::Distance { .. } => 1,
+            })
+            .sum();
+        let dof = 3 * moving as i64 - joint_equations as i64;
+        let drivers = spec.drivers.len() as i64;
+        let count = format!(
+            "Gruebler count: 3 × {moving} moving bodies − {joint_equations} joint equations = {dof}"
+        );
+        if dof < 0 {
+            self.errors.push(
+                spec.name.span(),
+                format!(
+                    "the joints over-constrain the mechanism ({count}); remove joints or add \
+                     bodies"
+                ),
+            );
+        } else if drivers < dof {
+            let missing = dof - drivers;
+            self.errors.push(
+                spec.name.span(),
+                format!(
+                    "`{}` has {dof} degree{} of freedom but {drivers} driver{} ({count}); add \
+                     {missing} driver{}, e.g. `driver NAME: angle(BODY) = omega * t;`",
+                    spec.name,
+                    plural(dof),
+                    plural(drivers),
+                    plural(missing),
+                ),
+            );
+        } else if drivers > dof {
+            let extra = drivers - dof;
+            for driver in spec.drivers.iter().skip(dof as usize) {
+                self.errors.push(
+                    driver.name.span(),
+                    format!(
+                        "too many drivers: `{}` has {dof} degree{} of freedom but {drivers} \
+                         drivers ({count}); remove {extra} driver{}",
+                        spec.name,
+                        plural(dof),
+                        plural(extra),
+                    ),
+                );
+            }
+        }
+    }
+
+    /// A parameter default: a constant expression.
+    fn constant(&mut self, e: &Expr) -> f64 {
+        let before = self.errors.len();
+        let id = self.lower_with(e, false, false);
+        match self.arena.as_const(id) {
+            Some(v) => v,
+            None => {
+                if self.errors.len() == before {
+                    self.errors.push(
+                        e.span,
+                        "a parameter default must be a finite constant, such as `314.0`",
+                    );
+                }
+                0.0
+            }
+        }
+    }
+
+    /// Geometry: parameters allowed, time not.
+    fn geometry(&mut self, e: &Expr) -> Id {
+        self.lower_with(e, true, false)
+    }
+
+    /// A driver's value: parameters and time allowed.
+    fn lower(&mut self, e: &Expr, allow_t: bool) -> Id {
+        self.lower_with(e, true, allow_t)
+    }
+
+    fn lower_with(&mut self, e: &Expr, allow_params: bool, allow_t: bool) -> Id {
+        match &e.kind {
+            ExprKind::Number(v) => self.arena.constant(*v),
+            ExprKind::Name(name) => {
+                let key = name.to_string();
+                if key == "t" {
+                    if !allow_t {
+                        self.errors.push(
+                            name.span(),
+                            "time `t` can only appear in a driver's value; geometry and \
+                             defaults are constant or use parameters",
+                        );
+                    }
+                    return self.arena.var(Var::T);
+                }
+                match self.params.get(&key) {
+                    Some(&index) if allow_params => self.arena.param(index),
+                    Some(_) => {
+                        self.errors.push(
+                            name.span(),
+                            "a parameter default must be a number, not another parameter",
+                        );
+                        self.arena.zero()
+                    }
+                    None => {
+                        let mut names: Vec<(&String, &u32)> = self.params.iter().collect();
+                        names.sort_by_key(|(_, i)| **i);
+                        let hint = if names.is_empty() {
+                            "declare it with `param NAME = VALUE;`".to_owned()
+                        } else {
+                            let list: Vec<String> =
+                                names.iter().map(|(n, _)| format!("`{n}`")).collect();
+                            format!("declared parameters are {}", list.join(", "))
+                        };
+                        self.errors.push(
+                            name.span(),
+                            format!("unknown name `{key}`: not `t` or a parameter; {hint}"),
+                        );
+                        self.arena.zero()
+                    }
+                }
+            }
+            ExprKind::Neg(a) => {
+                let a = self.lower_with(a, allow_params, allow_t);
+                self.arena.neg(a)
+            }
+            ExprKind::Binary(op, a, b) => {
+                let a = self.lower_with(a, allow_params, allow_t);
+                let b = self.lower_with(b, allow_params, allow_t);
+                match op {
+                    BinOp::Add => self.arena.add(a, b),
+                    BinOp::Sub => self.arena.sub(a, b),
+                    BinOp::Mul => self.arena.mul(a, b),
+                    BinOp::Div => {
+                        if self.arena.as_const(b) == Some(0.0) {
+                            self.errors.push(e.span, "division by zero");
+                        }
+                        self.arena.div(a, b)
+                    }
+                }
+            }
+            ExprKind::Pow(a, n) => {
+                let a = self.lower_with(a, allow_params, allow_t);
+                self.arena.powi(a, *n)
+            }
+            ExprKind::Call(f, a) => {
+                let arg = self.lower_with(a, allow_params, allow_t);
+                match Func::from_name(&f.to_string()) {
+                    Some(func) => self.arena.call(func, arg),
+                    None => {
+                        let names: Vec<&str> = Func::ALL.iter().map(|f| f.name()).collect();
+                        self.errors.push(
+                            f.span(),
+                            format!(
+                                "unknown function `{f}`; supported functions are {}",
+                                names.join(", ")
+                            ),
+                        );
+                        self.arena.zero()
+                    }
+                }
+            }
+        }
+    }
+}
+
+fn plural(n: i64) -> &'static str {
+    if n == 1 { "" } else { "s" }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::parse::parse_str;
+
+    fn errors(source: &str) -> Vec<String> {
+        let spec = parse_str(source).ok().expect("syntax");
+        match check(&spec) {
+            Ok(_) => Vec::new(),
+            Err(e) => e.messages(),
+        }
+    }
+
+    const SLIDER: &str = "
+        param w = 2;
+        ground frame at (0, 0, 0);
+        body crank near (0, 0, 0);
+        body rod near (1, 0, 0);
+        body slider near (2, 0, 0);
+        joint o: revolute(frame, crank);
+        joint a: revolute(crank @ (1, 0), rod);
+        joint b: revolute(rod @ (2, 0), slider);
+        joint s: prismatic(frame, slider, along (1, 0));
+    ";
+
+    fn scene(extra: &str) -> String {
+        format!("mechanism M {{ {SLIDER} {extra} }}")
+    }
+
+    #[test]
+    fn a_valid_scene_checks() {
+        let spec = parse_str(&scene("driver d: angle(crank) = w * t;")).ok().expect("parses");
+        let model = check(&spec).ok().expect("checks");
+        assert_eq!(model.dim(), 12);
+        assert_eq!(model.equation_names().len(), 12);
+        assert_eq!(model.equation_names()[0], "frame.x");
+        assert_eq!(model.equation_names()[11], "d");
+        assert_eq!(model.coordinate_names()[3], "crank.x");
+    }
+
+    #[test]
+    fn reports_every_error_together() {
+        let msgs = errors(&scene(
+            "joint self_loop: revolute(rod, rod); driver d: angle(wheel) = w * t; \
+             driver g: angle(frame) = sin(t); driver h: angle(crank) = q * cosh(t);",
+        ));
+        let all = msgs.join("\n");
+        assert!(all.contains("connects `rod` to itself"), "{all}");
+        assert!(all.contains("unknown body `wheel`"), "{all}");
+        assert!(all.contains("ground body and never moves"), "{all}");
+        assert!(all.contains("unknown name `q`"), "{all}");
+        assert!(all.contains("unknown function `cosh`"), "{all}");
+    }
+
+    #[test]
+    fn degrees_of_freedom_must_match_drivers() {
+        let missing = errors(&scene("")).join("\n");
+        assert!(missing.contains("1 degree of freedom but 0 drivers"), "{missing}");
+        let extra = errors(&scene(
+            "driver d: angle(crank) = t; driver e: x(slider) = t;",
+        ))
+        .join("\n");
+        assert!(extra.contains("too many drivers"), "{extra}");
+    }
+
+    #[test]
+    fn duplicate_and_reserved_names() {
+        let msgs = errors(&scene("driver crank: angle(crank) = t;")).join("\n");
+        assert!(msgs.contains("duplicate name `crank`"), "{msgs}");
+        let msgs = errors(&scene("param t = 1; driver d: angle(crank) = t;")).join("\n");
+        assert!(msgs.contains("`t` is time"), "{msgs}");
+    }
+
+    #[test]
+    fn geometry_cannot_depend_on_time_and_axes_cannot_vanish() {
+        let msgs = errors(
+            "mechanism M { ground f at (t, 0, 0); body b near (0,0,0);
+               joint p: prismatic(f, b, along (0, 0)); joint l: distance(f, b, 0);
+               driver d: angle(b) = t; }",
+        )
+        .join("\n");
+        assert!(msgs.contains("time `t` can only appear"), "{msgs}");
+        assert!(msgs.contains("zero vector"), "{msgs}");
+        assert!(msgs.contains("distance of zero"), "{msgs}");
+    }
+
+    #[test]
+    fn travel_needs_a_prismatic_joint() {
+        let msgs = errors(&scene("driver d: travel(o) = t;")).join("\n");
+        assert!(msgs.contains("not a prismatic joint"), "{msgs}");
+        assert!(errors(&scene("driver d: travel(s) = 1 + t;")).is_empty());
+    }
+}

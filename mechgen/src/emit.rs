@@ -1,0 +1,619 @@
+//! Emission: a model and its kinematics as straight-line Rust (`quote!`).
+//!
+//! Each generated function evaluates the DAG reachable from its outputs once, in a deterministic
+//! topological order: a node used more than once, and every elementary function call, becomes a
+//! `let`; a node used once is written inline. No loops, no allocation, no `std`, no `unsafe`;
+//! elementary functions come from `::mechgen_runtime::math`. Zero entries are never computed: the
+//! output is cleared once and only non-zeros are written.
+
+use std::collections::{BTreeSet, HashSet};
+
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::{format_ident, quote};
+
+use crate::expr::{Arena, Func, Id, Node, Var};
+use crate::interpret::topological_order;
+use crate::kinematics::Kinematics;
+use crate::model::{COORDINATE_SUFFIXES, Model};
+use crate::stats::OpCounts;
+
+/// Emits the whole item set for a scene: the parameter struct, its constants, the `Mechanism`
+/// implementation and the named body accessors.
+pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
+    let name = &model.name;
+    let vis = &model.vis;
+    let docs = &model.docs;
+    let n = model.dim();
+    let n_lit = idx(n);
+    let coordinate_names = model.coordinate_names();
+    let equation_names = model.equation_names();
+
+    let param_fields = model.params.iter().map(|p| {
+        let (docs, name) = (&p.docs, &p.name);
+        quote! { #(#docs)* pub #name: f64, }
+    });
+    let param_defaults = model.params.iter().map(|p| {
+        let (name, value) = (&p.name, f64_literal(p.default));
+        quote! { #name: #value, }
+    });
+    let param_names: Vec<String> = model.params.iter().map(|p| p.name.to_string()).collect();
+    let param_count = idx(param_names.len());
+    let param_reads = model.params.iter().enumerate().map(|(i, p)| {
+        let (i, name) = (idx(i), &p.name);
+        quote! { #i => ::core::option::Option::Some(self.#name), }
+    });
+    let param_writes = model.params.iter().map(|p| {
+        let (name, key) = (&p.name, p.name.to_string());
+        quote! { #key => self.#name = value, }
+    });
+
+    let coordinate_consts = coordinate_names.iter().enumerate().map(|(i, c)| {
+        let ident = format_ident!("{}", c.replace('.', "_").to_uppercase());
+        let doc = format!(" Index of `{c}` in q.");
+        let i = idx(i);
+        quote! { #[doc = #doc] pub const #ident: usize = #i; }
+    });
+    let jacobian_count = idx(kin.jacobian.len());
+    let pattern = kin.jacobian.iter().map(|e| {
+        let (r, c) = (idx(e.row), idx(e.col));
+        quote! { (#r, #c) }
+    });
+
+    let cx = Context { model };
+    let vector = |values: &[Id], target: TokenStream| {
+        let clear = clear_if_sparse(&model.arena, values, &target);
+        (vector_outputs(values, &target), clear)
+    };
+    let jacobian_outputs = |target: TokenStream| {
+        let outputs: Vec<(TokenStream, Id)> = kin
+            .jacobian
+            .iter()
+            .map(|e| (matrix_target(&target, e.row, e.col), e.value))
+            .collect();
+        let clear = if kin.jacobian.len() < n * n {
+            quote! { #target.fill(0.0); }
+        } else {
+            TokenStream::new()
+        };
+        (outputs, clear)
+    };
+    let guess = {
+        let (outputs, clear) = vector(&kin.guess, quote!(q));
+        cx.function(&outputs, clear)
+    };
+    let phi = {
+        let (outputs, clear) = vector(&kin.phi, quote!(out));
+        cx.function(&outputs, clear)
+    };
+    let jacobian = {
+        let (outputs, clear) = jacobian_outputs(quote!(out));
+        cx.function(&outputs, clear)
+    };
+    let phi_and_jacobian = {
+        let (mut outputs, mut clear) = vector(&kin.phi, quote!(phi));
+        let (jac_outputs, jac_clear) = jacobian_outputs(quote!(jacobian));
+        outputs.extend(jac_outputs);
+        clear.extend(jac_clear);
+        cx.function(&outputs, clear)
+    };
+    let nu = {
+        let (outputs, clear) = vector(&kin.nu, quote!(out));
+        cx.function(&outputs, clear)
+    };
+    let gamma = {
+        let (outputs, clear) = vector(&kin.gamma, quote!(out));
+        cx.function(&outputs, clear)
+    };
+
+    let guess_body = guess.body;
+    let (phi_doc, phi_body, phi_args) = (phi.doc("Φ(q, t)"), phi.body, phi.args);
+    let (jac_doc, jac_body, jac_args) = (jacobian.doc("Φ_q(q, t)"), jacobian.body, jacobian.args);
+    let (pj_doc, pj_body, pj_args) = (
+        phi_and_jacobian.doc("Φ and Φ_q together, sharing sub-expressions"),
+        phi_and_jacobian.body,
+        phi_and_jacobian.args,
+    );
+    let (nu_doc, nu_body, nu_args) = (nu.doc("ν = −Φ_t"), nu.body, nu.args);
+    let (gamma_doc, gamma_body, gamma_args) = (gamma.doc("γ(q, q̇, t)"), gamma.body, gamma.args);
+    let [phi_q, _, phi_t] = phi_args;
+    let [jac_q, _, jac_t] = jac_args;
+    let [pj_q, _, pj_t] = pj_args;
+    let [nu_q, _, nu_t] = nu_args;
+    let [gamma_q, gamma_qd, gamma_t] = gamma_args;
+
+    let bodies_trait = format_ident!("{}Bodies", name);
+    let bodies_doc = format!(
+        " Named access to the bodies of a solved [`{name}`] state: `state.{}().x`.",
+        model.bodies.first().map_or("body".to_owned(), |b| b.name.to_string())
+    );
+    let accessor_decls = model.bodies.iter().map(|b| {
+        let ident = &b.name;
+        let docs = if b.docs.is_empty() {
+            let doc = format!(" Pose, velocity and acceleration of `{ident}`.");
+            quote! { #[doc = #doc] }
+        } else {
+            let docs = &b.docs;
+            quote! { #(#docs)* }
+        };
+        quote! { #docs fn #ident(&self) -> ::mechgen_runtime::BodyState; }
+    });
+    let accessor_impls = model.bodies.iter().enumerate().map(|(i, b)| {
+        let ident = &b.name;
+        let [x, y, th] = [3 * i, 3 * i + 1, 3 * i + 2].map(idx);
+        quote! {
+            fn #ident(&self) -> ::mechgen_runtime::BodyState {
+                ::mechgen_runtime::BodyState {
+                    x: self.q[#x], y: self.q[#y], theta: self.q[#th],
+                    x_dot: self.qd[#x], y_dot: self.qd[#y], theta_dot: self.qd[#th],
+                    x_ddot: self.qdd[#x], y_ddot: self.qdd[#y], theta_ddot: self.qdd[#th],
+                }
+            }
+        }
+    });
+
+    let coordinate_doc = format!(" Coordinate names in q order ({n} = 3 × {} bodies).", model.bodies.len());
+    let equation_doc = format!(" Equation names in Φ order ({n} equations).");
+    let pattern_doc = format!(
+        " Structural non-zeros of Φ_q as (equation, coordinate), row-major: {jacobian_count} of {}.",
+        n * n
+    );
+
+    quote! {
+        #(#docs)*
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        #vis struct #name {
+            #(#param_fields)*
+        }
+
+        impl ::core::default::Default for #name {
+            fn default() -> Self {
+                Self { #(#param_defaults)* }
+            }
+        }
+
+        impl #name {
+            /// Number of coordinates (= number of equations).
+            pub const DIM: usize = #n_lit;
+            #[doc = #coordinate_doc]
+            pub const COORDINATES: [&'static str; #n_lit] = [#(#coordinate_names),*];
+            #[doc = #equation_doc]
+            pub const EQUATIONS: [&'static str; #n_lit] = [#(#equation_names),*];
+            /// Run-time parameter names, in declaration order.
+            pub const PARAMETERS: [&'static str; #param_count] = [#(#param_names),*];
+            #[doc = #pattern_doc]
+            pub const JACOBIAN_PATTERN: [(usize, usize); #jacobian_count] = [#(#pattern),*];
+            #(#coordinate_consts)*
+        }
+
+        impl ::mechgen_runtime::Mechanism for #name {
+            type Dim = ::mechgen_runtime::nalgebra::Const<#n_lit>;
+
+            fn dim(&self) -> Self::Dim {
+                ::mechgen_runtime::nalgebra::Const::<#n_lit>
+            }
+
+            fn coordinate_name(&self, index: usize) -> ::core::option::Option<&str> {
+                Self::COORDINATES.get(index).copied()
+            }
+
+            fn equation_name(&self, index: usize) -> ::core::option::Option<&str> {
+                Self::EQUATIONS.get(index).copied()
+            }
+
+            fn parameter_count(&self) -> usize {
+                #param_count
+            }
+
+            fn parameter_name(&self, index: usize) -> ::core::option::Option<&str> {
+                Self::PARAMETERS.get(index).copied()
+            }
+
+            fn parameter(&self, index: usize) -> ::core::option::Option<f64> {
+                match index {
+                    #(#param_reads)*
+                    _ => ::core::option::Option::None,
+                }
+            }
+
+            fn set_parameter(
+                &mut self,
+                name: &str,
+                value: f64,
+            ) -> ::core::result::Result<(), ::mechgen_runtime::ParameterError> {
+                if !value.is_finite() {
+                    return ::core::result::Result::Err(::mechgen_runtime::ParameterError::NonFinite);
+                }
+                match name {
+                    #(#param_writes)*
+                    _ => return ::core::result::Result::Err(::mechgen_runtime::ParameterError::Unknown),
+                }
+                #[allow(unreachable_code)]
+                ::core::result::Result::Ok(())
+            }
+
+            fn initial_guess(&self, q: &mut ::mechgen_runtime::Vector<Self::Dim>) {
+                #guess_body
+            }
+
+            #[doc = #phi_doc]
+            fn phi(
+                &self,
+                #phi_q: &::mechgen_runtime::Vector<Self::Dim>,
+                #phi_t: f64,
+                out: &mut ::mechgen_runtime::Vector<Self::Dim>,
+            ) {
+                #phi_body
+            }
+
+            #[doc = #jac_doc]
+            fn jacobian(
+                &self,
+                #jac_q: &::mechgen_runtime::Vector<Self::Dim>,
+                #jac_t: f64,
+                out: &mut ::mechgen_runtime::Matrix<Self::Dim>,
+            ) {
+                #jac_body
+            }
+
+            #[doc = #pj_doc]
+            fn phi_and_jacobian(
+                &self,
+                #pj_q: &::mechgen_runtime::Vector<Self::Dim>,
+                #pj_t: f64,
+                phi: &mut ::mechgen_runtime::Vector<Self::Dim>,
+                jacobian: &mut ::mechgen_runtime::Matrix<Self::Dim>,
+            ) {
+                #pj_body
+            }
+
+            #[doc = #nu_doc]
+            fn nu(
+                &self,
+                #nu_q: &::mechgen_runtime::Vector<Self::Dim>,
+                #nu_t: f64,
+                out: &mut ::mechgen_runtime::Vector<Self::Dim>,
+            ) {
+                #nu_body
+            }
+
+            #[doc = #gamma_doc]
+            fn gamma(
+                &self,
+                #gamma_q: &::mechgen_runtime::Vector<Self::Dim>,
+                #gamma_qd: &::mechgen_runtime::Vector<Self::Dim>,
+                #gamma_t: f64,
+                out: &mut ::mechgen_runtime::Vector<Self::Dim>,
+            ) {
+                #gamma_body
+            }
+        }
+
+        #[doc = #bodies_doc]
+        #vis trait #bodies_trait {
+            #(#accessor_decls)*
+        }
+
+        impl #bodies_trait for ::mechgen_runtime::State<#name> {
+            #(#accessor_impls)*
+        }
+    }
+}
+
+fn vector_outputs(values: &[Id], target: &TokenStream) -> Vec<(TokenStream, Id)> {
+    values
+        .iter()
+        .enumerate()
+        .map(|(i, &id)| {
+            let i = idx(i);
+            (quote!(#target[#i]), id)
+        })
+        .collect()
+}
+
+/// An index or size literal without a `usize` suffix (generated code is read by people).
+fn idx(i: usize) -> Literal {
+    Literal::usize_unsuffixed(i)
+}
+
+/// `out[(r, c)]` for a Jacobian entry.
+fn matrix_target(target: &TokenStream, row: usize, col: usize) -> TokenStream {
+    let (r, c) = (idx(row), idx(col));
+    quote!(#target[(#r, #c)])
+}
+
+/// `target.fill(0.0);` if some of `values` are identically zero (only non-zeros are written).
+fn clear_if_sparse(arena: &Arena, values: &[Id], target: &TokenStream) -> TokenStream {
+    if values.iter().any(|&v| arena.is_zero(v)) {
+        quote! { #target.fill(0.0); }
+    } else {
+        TokenStream::new()
+    }
+}
+
+/// One generated function body with the names its arguments must take (`q` or `_q` if unused).
+struct Function {
+    body: TokenStream,
+    /// Argument names for q, q̇, t.
+    args: [Ident; 3],
+    counts: OpCounts,
+}
+
+impl Function {
+    fn doc(&self, what: &str) -> String {
+        format!(" Writes {what}. Operations: {}.", self.counts)
+    }
+}
+
+struct Context<'a> {
+    model: &'a Model,
+}
+
+impl Context<'_> {
+    fn arena(&self) -> &Arena {
+        &self.model.arena
+    }
+
+    /// A function body writing `outputs` (non-zero entries; zeros are cleared in one call).
+    fn function(&self, outputs: &[(TokenStream, Id)], clear: TokenStream) -> Function {
+        let arena = self.arena();
+        let nonzero: Vec<&(TokenStream, Id)> =
+            outputs.iter().filter(|(_, id)| !arena.is_zero(*id)).collect();
+        let roots: Vec<Id> = nonzero.iter().map(|(_, id)| *id).collect();
+        let order = topological_order(arena, &roots);
+
+        let mut uses = vec![0usize; arena.len()];
+        for &id in &order {
+            for child in arena.children(id) {
+                uses[child.index()] += 1;
+            }
+        }
+        for &id in &roots {
+            uses[id.index()] += 1;
+        }
+
+        let mut names = Names::default();
+        let mut bound: Vec<Option<Ident>> = vec![None; arena.len()];
+        let mut rendered: Vec<Option<(TokenStream, Prec)>> = vec![None; arena.len()];
+        let mut lets = Vec::new();
+        // Coordinate loads go first, in q order: the reader sees the inputs, then the work.
+        let mut loads: Vec<(Var, TokenStream)> = Vec::new();
+        let mut funcs = BTreeSet::new();
+        let mut used = [false; 3];
+        let counts = OpCounts::of(arena, &order);
+
+        for &id in &order {
+            let node = arena.node(id);
+            let operand = |x: Id| -> (TokenStream, Prec) {
+                match &bound[x.index()] {
+                    Some(ident) => (quote!(#ident), Prec::Atom),
+                    None => rendered[x.index()].clone().unwrap_or_else(|| (quote!(0.0), Prec::Atom)),
+                }
+            };
+            let (tokens, prec) = match node {
+                Node::Const(bits) => {
+                    let value = f64::from_bits(bits);
+                    // Negative literals are written `-c` and parenthesised like a sum in operands.
+                    let prec = if value < 0.0 { Prec::Sum } else { Prec::Atom };
+                    (f64_literal(value), prec)
+                }
+                Node::Param(i) => {
+                    let name = &self.model.params[i as usize].name;
+                    (quote!(self.#name), Prec::Atom)
+                }
+                Node::Var(Var::T) => {
+                    used[2] = true;
+                    (quote!(t), Prec::Atom)
+                }
+                Node::Var(Var::Q(k)) => {
+                    used[0] = true;
+                    let k = idx(k as usize);
+                    (quote!(q[#k]), Prec::Atom)
+                }
+                Node::Var(Var::Qd(k)) => {
+                    used[1] = true;
+                    let k = idx(k as usize);
+                    (quote!(qd[#k]), Prec::Atom)
+                }
+                Node::Neg(a) => {
+                    let a = operand(a).wrap(Prec::Unary);
+                    (quote!(-#a), Prec::Unary)
+                }
+                Node::Add(a, b) => binary(operand(a), quote!(+), operand(b), Prec::Sum),
+                Node::Sub(a, b) => binary(operand(a), quote!(-), operand(b), Prec::Sum),
+                Node::Mul(a, b) => binary(operand(a), quote!(*), operand(b), Prec::Product),
+                Node::Div(a, b) => binary(operand(a), quote!(/), operand(b), Prec::Product),
+                Node::Powi(a, n) => {
+                    funcs.insert("powi");
+                    let a = operand(a).0;
+                    (quote!(powi(#a, #n)), Prec::Atom)
+                }
+                Node::Call(f, a) => {
+                    funcs.insert(f.name());
+                    let f_ident = format_ident!("{}", f.name());
+                    let a = operand(a).0;
+                    (quote!(#f_ident(#a)), Prec::Atom)
+                }
+            };
+            let is_leaf = matches!(node, Node::Const(_) | Node::Param(_) | Node::Var(Var::T));
+            let bind = !is_leaf
+                && (matches!(node, Node::Var(_) | Node::Call(..)) || uses[id.index()] > 1);
+            if bind {
+                let ident = names.fresh(&self.suggest(id));
+                let statement = quote! { let #ident = #tokens; };
+                match node {
+                    Node::Var(v) => loads.push((v, statement)),
+                    _ => lets.push(statement),
+                }
+                bound[id.index()] = Some(ident);
+            } else {
+                rendered[id.index()] = Some((tokens, prec));
+            }
+        }
+
+        let writes = nonzero.iter().map(|(target, id)| {
+            let value = match &bound[id.index()] {
+                Some(ident) => quote!(#ident),
+                None => rendered[id.index()]
+                    .clone()
+                    .map_or_else(|| quote!(0.0), |(t, _)| t),
+            };
+            quote! { #target = #value; }
+        });
+        let imports = if funcs.is_empty() {
+            TokenStream::new()
+        } else {
+            let funcs = funcs.iter().map(|f| format_ident!("{}", f));
+            quote! { use ::mechgen_runtime::math::{#(#funcs),*}; }
+        };
+        let arg = |used: bool, name: &str| {
+            if used {
+                format_ident!("{}", name)
+            } else {
+                format_ident!("_{}", name)
+            }
+        };
+        loads.sort_by_key(|(v, _)| *v);
+        let loads = loads.into_iter().map(|(_, statement)| statement);
+        Function {
+            body: quote! { #imports #(#loads)* #(#lets)* #clear #(#writes)* },
+            args: [arg(used[0], "q"), arg(used[1], "qd"), arg(used[2], "t")],
+            counts,
+        }
+    }
+
+    /// A readable name for a bound node: `rod_theta`, `sin_rod_theta`, `piston_x_dot`, or `e`.
+    fn suggest(&self, id: Id) -> String {
+        let arena = self.arena();
+        let coordinate = |k: u32| {
+            let k = k as usize;
+            let body = &self.model.bodies[k / 3].name;
+            format!("{body}_{}", COORDINATE_SUFFIXES[k % 3])
+        };
+        match arena.node(id) {
+            Node::Var(Var::Q(k)) => coordinate(k),
+            Node::Var(Var::Qd(k)) => format!("{}_dot", coordinate(k)),
+            Node::Call(f, a) => match arena.node(a) {
+                Node::Var(Var::Q(k)) => format!("{}_{}", f.name(), coordinate(k)),
+                _ => f.name().to_owned() + "_",
+            },
+            _ => "e".to_owned(),
+        }
+    }
+}
+
+/// Unique, hygienic local names (numbered where a suggestion repeats).
+#[derive(Default)]
+struct Names {
+    taken: HashSet<String>,
+    counter: usize,
+}
+
+impl Names {
+    fn fresh(&mut self, suggestion: &str) -> Ident {
+        let numbered = suggestion.ends_with('_') || suggestion == "e";
+        let mut candidate = suggestion.trim_end_matches('_').to_owned();
+        if numbered || self.taken.contains(&candidate) || Func::from_name(&candidate).is_some() {
+            loop {
+                let next = format!("{}{}", candidate.trim_end_matches('_'), self.counter);
+                self.counter += 1;
+                if !self.taken.contains(&next) {
+                    candidate = next;
+                    break;
+                }
+            }
+        }
+        self.taken.insert(candidate.clone());
+        Ident::new(&candidate, Span::mixed_site())
+    }
+}
+
+/// Binding strength, for parenthesising inlined operands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Prec {
+    Sum,
+    Product,
+    Unary,
+    Atom,
+}
+
+trait Wrap {
+    fn wrap(self, min: Prec) -> TokenStream;
+}
+
+impl Wrap for (TokenStream, Prec) {
+    fn wrap(self, min: Prec) -> TokenStream {
+        let (tokens, prec) = self;
+        if prec < min {
+            quote!((#tokens))
+        } else {
+            tokens
+        }
+    }
+}
+
+/// `a op b`, left-associative: the right operand is parenthesised at equal precedence so the
+/// generated code evaluates in exactly the DAG's order (same rounding as the interpreter).
+fn binary(
+    a: (TokenStream, Prec),
+    op: TokenStream,
+    b: (TokenStream, Prec),
+    prec: Prec,
+) -> (TokenStream, Prec) {
+    let a = a.wrap(prec);
+    let b = if b.1 <= prec {
+        let tokens = b.0;
+        quote!((#tokens))
+    } else {
+        b.0
+    };
+    (quote!(#a #op #b), prec)
+}
+
+/// An `f64` literal that round-trips exactly (`-c` for negative values; operands that need it
+/// are parenthesised by the caller).
+pub fn f64_literal(value: f64) -> TokenStream {
+    if !value.is_finite() {
+        // Unreachable for checked models (literals are validated, folding keeps finiteness);
+        // kept total so emission can never panic.
+        return if value.is_nan() {
+            quote!(f64::NAN)
+        } else if value > 0.0 {
+            quote!(f64::INFINITY)
+        } else {
+            quote!(f64::NEG_INFINITY)
+        };
+    }
+    let magnitude = value.abs();
+    // `{:?}` is the shortest representation that round-trips, with an exponent for extremes.
+    let text = format!("{magnitude:?}");
+    let literal: Literal = text.parse().unwrap_or_else(|_| Literal::f64_unsuffixed(magnitude));
+    if value.is_sign_negative() {
+        quote!(-#literal)
+    } else {
+        quote!(#literal)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn literals_round_trip() {
+        for v in [0.0, 1.0, 156.8, 1e-6, 1e-300, 6.02e23, 0.1 + 0.2, f64::MAX, -2.5] {
+            let text = f64_literal(v).to_string().replace(['(', ')', ' '], "");
+            assert_eq!(text.parse::<f64>().unwrap(), v, "{text}");
+        }
+        assert_eq!(f64_literal(-2.5).to_string(), "- 2.5");
+        assert_eq!(f64_literal(3.0).to_string(), "3.0");
+    }
+
+    #[test]
+    fn names_are_unique_and_numbered() {
+        let mut names = Names::default();
+        assert_eq!(names.fresh("rod_theta").to_string(), "rod_theta");
+        assert_eq!(names.fresh("rod_theta").to_string(), "rod_theta0");
+        assert_eq!(names.fresh("e").to_string(), "e1");
+        assert_eq!(names.fresh("sin_").to_string(), "sin2");
+    }
+}

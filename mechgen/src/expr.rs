@@ -1,0 +1,520 @@
+//! The expression IR: a hash-consed DAG of scalar expressions over q, q̇, t and parameters.
+//!
+//! Every node lives once in an [`Arena`]; structurally equal expressions get the same [`Id`], so
+//! common sub-expressions (each sin θ, cos θ, products of them) are shared by construction and the
+//! emitter binds each of them once. The constructors simplify as they build (constant folding,
+//! `x·0`, `x·1`, `x+0`, `−(−x)`, functions of constants), so no separate simplification pass can be
+//! forgotten and no identically-zero expression survives as anything but [`Arena::zero`].
+
+use std::collections::HashMap;
+
+/// Handle of a node in an [`Arena`]. Ids are dense and ordered by creation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Id(u32);
+
+impl Id {
+    /// Position of the node in the arena (creation order).
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// A variable an expression can be differentiated with respect to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Var {
+    /// Coordinate q_k.
+    Q(u32),
+    /// Coordinate velocity q̇_k (an independent symbol when forming γ).
+    Qd(u32),
+    /// Time.
+    T,
+}
+
+/// Elementary functions of the spec language.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Func {
+    /// Sine.
+    Sin,
+    /// Cosine.
+    Cos,
+    /// Tangent.
+    Tan,
+    /// Natural exponential.
+    Exp,
+    /// Natural logarithm.
+    Ln,
+    /// Square root.
+    Sqrt,
+}
+
+impl Func {
+    /// Every function, for error messages.
+    pub const ALL: [Func; 6] = [
+        Func::Sin,
+        Func::Cos,
+        Func::Tan,
+        Func::Exp,
+        Func::Ln,
+        Func::Sqrt,
+    ];
+
+    /// The name used in specs and in generated code (`::mechgen_runtime::math::NAME`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Func::Sin => "sin",
+            Func::Cos => "cos",
+            Func::Tan => "tan",
+            Func::Exp => "exp",
+            Func::Ln => "ln",
+            Func::Sqrt => "sqrt",
+        }
+    }
+
+    /// Looks a function up by its spec name.
+    pub fn from_name(name: &str) -> Option<Func> {
+        Func::ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// Evaluates the function (used for constant folding and by the interpreter).
+    pub fn apply(self, x: f64) -> f64 {
+        match self {
+            Func::Sin => x.sin(),
+            Func::Cos => x.cos(),
+            Func::Tan => x.tan(),
+            Func::Exp => x.exp(),
+            Func::Ln => x.ln(),
+            Func::Sqrt => x.sqrt(),
+        }
+    }
+}
+
+/// One node of the DAG. Constants are stored as bit patterns so nodes can be hashed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Node {
+    /// A finite literal (bits of an `f64`).
+    Const(u64),
+    /// Run-time parameter by declaration index.
+    Param(u32),
+    /// A variable: q_k, q̇_k or t.
+    Var(Var),
+    /// −a
+    Neg(Id),
+    /// a + b
+    Add(Id, Id),
+    /// a − b
+    Sub(Id, Id),
+    /// a · b
+    Mul(Id, Id),
+    /// a / b
+    Div(Id, Id),
+    /// a raised to an integer power (|n| ≥ 2 after simplification).
+    Powi(Id, i32),
+    /// f(a)
+    Call(Func, Id),
+}
+
+/// The arena holding every node; see the module docs.
+#[derive(Debug, Clone)]
+pub struct Arena {
+    nodes: Vec<Node>,
+    lookup: HashMap<Node, Id>,
+    zero: Id,
+    one: Id,
+}
+
+impl Default for Arena {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Arena {
+    /// An arena holding the constants 0 and 1.
+    pub fn new() -> Self {
+        let mut arena = Arena {
+            nodes: Vec::new(),
+            lookup: HashMap::new(),
+            zero: Id(0),
+            one: Id(0),
+        };
+        arena.zero = arena.intern(Node::Const(0f64.to_bits()));
+        arena.one = arena.intern(Node::Const(1f64.to_bits()));
+        arena
+    }
+
+    /// The node behind an id.
+    pub fn node(&self, id: Id) -> Node {
+        self.nodes[id.index()]
+    }
+
+    /// Number of nodes created so far.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// True if only the built-in constants exist.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.len() <= 2
+    }
+
+    fn intern(&mut self, node: Node) -> Id {
+        if let Some(&id) = self.lookup.get(&node) {
+            return id;
+        }
+        let id = Id(u32::try_from(self.nodes.len()).expect("expression arena exceeds u32 nodes"));
+        self.nodes.push(node);
+        self.lookup.insert(node, id);
+        id
+    }
+
+    /// The constant 0.
+    pub fn zero(&self) -> Id {
+        self.zero
+    }
+
+    /// The constant 1.
+    pub fn one(&self) -> Id {
+        self.one
+    }
+
+    /// The constant value of a node, if it is one.
+    pub fn as_const(&self, id: Id) -> Option<f64> {
+        match self.node(id) {
+            Node::Const(bits) => Some(f64::from_bits(bits)),
+            _ => None,
+        }
+    }
+
+    /// True if the node is the constant 0 (identically zero after simplification).
+    pub fn is_zero(&self, id: Id) -> bool {
+        self.as_const(id) == Some(0.0)
+    }
+
+    /// A literal. Callers guarantee finiteness (user literals are checked, folding refuses
+    /// non-finite results); −0 is normalised to 0 so both share one node.
+    pub fn constant(&mut self, value: f64) -> Id {
+        let value = if value == 0.0 { 0.0 } else { value };
+        self.intern(Node::Const(value.to_bits()))
+    }
+
+    /// Folds `value` if it is finite, otherwise keeps the symbolic `node` (run time will then
+    /// report the non-finite value instead of the generator inventing one).
+    fn fold_or(&mut self, value: f64, node: Node) -> Id {
+        if value.is_finite() {
+            self.constant(value)
+        } else {
+            self.intern(node)
+        }
+    }
+
+    /// A run-time parameter.
+    pub fn param(&mut self, index: u32) -> Id {
+        self.intern(Node::Param(index))
+    }
+
+    /// A variable (q_k, q̇_k or t).
+    pub fn var(&mut self, var: Var) -> Id {
+        self.intern(Node::Var(var))
+    }
+
+    /// −a
+    pub fn neg(&mut self, a: Id) -> Id {
+        match self.node(a) {
+            Node::Const(bits) => self.constant(-f64::from_bits(bits)),
+            Node::Neg(inner) => inner,
+            Node::Sub(x, y) => self.sub(y, x),
+            // −(c·x) = (−c)·x: the constant absorbs the sign.
+            Node::Mul(c, x) if self.as_const(c).is_some() => self.negate_product(c, x),
+            _ => self.intern(Node::Neg(a)),
+        }
+    }
+
+    /// a + b
+    pub fn add(&mut self, a: Id, b: Id) -> Id {
+        match (self.node(a), self.node(b)) {
+            (Node::Const(x), Node::Const(y)) => {
+                let value = f64::from_bits(x) + f64::from_bits(y);
+                self.fold_or(value, Node::Add(a, b))
+            }
+            _ if self.is_zero(a) => b,
+            _ if self.is_zero(b) => a,
+            (_, Node::Neg(y)) => self.sub(a, y),
+            (Node::Neg(x), _) => self.sub(b, x),
+            // a + (−c)·y = a − c·y: signs live in the operator, constants stay positive.
+            (_, Node::Mul(c, y)) if self.as_const(c).is_some_and(|c| c < 0.0) => {
+                let positive = self.negate_product(c, y);
+                self.sub(a, positive)
+            }
+            (Node::Mul(c, x), _) if self.as_const(c).is_some_and(|c| c < 0.0) => {
+                let positive = self.negate_product(c, x);
+                self.sub(b, positive)
+            }
+            // Commutative: one canonical operand order so a+b and b+a share a node.
+            _ if b < a => self.intern(Node::Add(b, a)),
+            _ => self.intern(Node::Add(a, b)),
+        }
+    }
+
+    /// a − b
+    pub fn sub(&mut self, a: Id, b: Id) -> Id {
+        match (self.node(a), self.node(b)) {
+            (Node::Const(x), Node::Const(y)) => {
+                let value = f64::from_bits(x) - f64::from_bits(y);
+                self.fold_or(value, Node::Sub(a, b))
+            }
+            _ if a == b => self.zero,
+            _ if self.is_zero(b) => a,
+            _ if self.is_zero(a) => self.neg(b),
+            (_, Node::Neg(y)) => self.add(a, y),
+            (_, Node::Mul(c, y)) if self.as_const(c).is_some_and(|c| c < 0.0) => {
+                let positive = self.negate_product(c, y);
+                self.add(a, positive)
+            }
+            _ => self.intern(Node::Sub(a, b)),
+        }
+    }
+
+    /// (−c)·x for a constant node c.
+    fn negate_product(&mut self, c: Id, x: Id) -> Id {
+        let negated = self.constant(-self.as_const(c).unwrap_or(0.0));
+        self.mul(negated, x)
+    }
+
+    /// a · b
+    pub fn mul(&mut self, a: Id, b: Id) -> Id {
+        match (self.node(a), self.node(b)) {
+            (Node::Const(x), Node::Const(y)) => {
+                let value = f64::from_bits(x) * f64::from_bits(y);
+                self.fold_or(value, Node::Mul(a, b))
+            }
+            _ if self.is_zero(a) || self.is_zero(b) => self.zero,
+            _ if a == self.one => b,
+            _ if b == self.one => a,
+            (_, Node::Const(_)) => self.mul(b, a),
+            (Node::Const(c), _) if f64::from_bits(c) == -1.0 => self.neg(b),
+            // c1 · (c2 · x) = (c1 c2) · x
+            (Node::Const(c1), Node::Mul(inner, x)) if self.as_const(inner).is_some() => {
+                let value = f64::from_bits(c1) * self.as_const(inner).unwrap_or(1.0);
+                if value.is_finite() {
+                    let c = self.constant(value);
+                    self.mul(c, x)
+                } else {
+                    self.intern(Node::Mul(a, b))
+                }
+            }
+            // Pull negations out so that −x·y and x·(−y) share x·y.
+            (Node::Neg(x), _) => {
+                let product = self.mul(x, b);
+                self.neg(product)
+            }
+            (_, Node::Neg(y)) => {
+                let product = self.mul(a, y);
+                self.neg(product)
+            }
+            (Node::Const(_), _) => self.intern(Node::Mul(a, b)),
+            _ if b < a => self.intern(Node::Mul(b, a)),
+            _ => self.intern(Node::Mul(a, b)),
+        }
+    }
+
+    /// a / b
+    pub fn div(&mut self, a: Id, b: Id) -> Id {
+        match (self.node(a), self.node(b)) {
+            (Node::Const(x), Node::Const(y)) => {
+                let value = f64::from_bits(x) / f64::from_bits(y);
+                self.fold_or(value, Node::Div(a, b))
+            }
+            _ if b == self.one => a,
+            _ if self.is_zero(a) && !self.is_zero(b) => self.zero,
+            _ if a == b && self.as_const(a).is_none() => self.one,
+            _ => self.intern(Node::Div(a, b)),
+        }
+    }
+
+    /// a raised to the integer power n.
+    pub fn powi(&mut self, a: Id, n: i32) -> Id {
+        match n {
+            0 => self.one,
+            1 => a,
+            _ => match self.node(a) {
+                Node::Const(bits) => {
+                    let value = f64::from_bits(bits).powi(n);
+                    self.fold_or(value, Node::Powi(a, n))
+                }
+                _ => self.intern(Node::Powi(a, n)),
+            },
+        }
+    }
+
+    /// f(a)
+    pub fn call(&mut self, f: Func, a: Id) -> Id {
+        match self.node(a) {
+            Node::Const(bits) => {
+                let value = f.apply(f64::from_bits(bits));
+                self.fold_or(value, Node::Call(f, a))
+            }
+            _ => self.intern(Node::Call(f, a)),
+        }
+    }
+
+    /// sin a
+    pub fn sin(&mut self, a: Id) -> Id {
+        self.call(Func::Sin, a)
+    }
+
+    /// cos a
+    pub fn cos(&mut self, a: Id) -> Id {
+        self.call(Func::Cos, a)
+    }
+
+    /// The operands of a node, in order.
+    pub fn children(&self, id: Id) -> impl Iterator<Item = Id> {
+        let (a, b) = match self.node(id) {
+            Node::Const(_) | Node::Param(_) | Node::Var(_) => (None, None),
+            Node::Neg(a) | Node::Powi(a, _) | Node::Call(_, a) => (Some(a), None),
+            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => {
+                (Some(a), Some(b))
+            }
+        };
+        a.into_iter().chain(b)
+    }
+
+    /// True if `var` occurs in the expression.
+    pub fn depends_on(&self, id: Id, var: Var) -> bool {
+        self.any_node(id, |node| node == Node::Var(var))
+    }
+
+    /// True if some node reachable from `id` satisfies `pred`.
+    pub fn any_node(&self, id: Id, pred: impl Fn(Node) -> bool) -> bool {
+        let mut seen = vec![false; self.nodes.len()];
+        let mut stack = vec![id];
+        while let Some(next) = stack.pop() {
+            if std::mem::replace(&mut seen[next.index()], true) {
+                continue;
+            }
+            if pred(self.node(next)) {
+                return true;
+            }
+            stack.extend(self.children(next));
+        }
+        false
+    }
+
+    /// The variables occurring in an expression, sorted.
+    pub fn variables(&self, id: Id) -> Vec<Var> {
+        let mut seen = vec![false; self.nodes.len()];
+        let mut stack = vec![id];
+        let mut vars = Vec::new();
+        while let Some(next) = stack.pop() {
+            if std::mem::replace(&mut seen[next.index()], true) {
+                continue;
+            }
+            if let Node::Var(v) = self.node(next) {
+                vars.push(v);
+            }
+            stack.extend(self.children(next));
+        }
+        vars.sort_unstable();
+        vars
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn setup() -> (Arena, Id, Id) {
+        let mut a = Arena::new();
+        let x = a.var(Var::Q(0));
+        let y = a.var(Var::Q(1));
+        (a, x, y)
+    }
+
+    #[test]
+    fn identical_expressions_share_one_node() {
+        let (mut a, x, y) = setup();
+        let s1 = a.sin(x);
+        let s2 = a.sin(x);
+        assert_eq!(s1, s2);
+        assert_eq!(a.add(x, y), a.add(y, x));
+        assert_eq!(a.mul(x, y), a.mul(y, x));
+    }
+
+    #[test]
+    fn algebra_laws_simplify_on_construction() {
+        let (mut a, x, y) = setup();
+        let (zero, one) = (a.zero(), a.one());
+        assert_eq!(a.add(x, zero), x);
+        assert_eq!(a.add(zero, x), x);
+        assert_eq!(a.mul(x, zero), zero);
+        assert_eq!(a.mul(one, x), x);
+        assert_eq!(a.sub(x, x), zero);
+        assert_eq!(a.sub(x, zero), x);
+        let neg_x = a.neg(x);
+        assert_eq!(a.neg(neg_x), x);
+        assert_eq!(a.sub(zero, x), neg_x);
+        assert_eq!(a.add(y, neg_x), a.sub(y, x));
+        let minus_one = a.constant(-1.0);
+        assert_eq!(a.mul(minus_one, x), neg_x);
+        assert_eq!(a.powi(x, 1), x);
+        assert_eq!(a.powi(x, 0), one);
+        assert_eq!(a.div(x, one), x);
+        assert_eq!(a.div(zero, x), zero);
+        let neg_y = a.neg(y);
+        let xy = a.mul(x, y);
+        let neg_xy = a.neg(xy);
+        assert_eq!(a.mul(neg_x, y), neg_xy);
+        assert_eq!(a.mul(x, neg_y), neg_xy);
+    }
+
+    #[test]
+    fn constants_fold_including_functions() {
+        let mut a = Arena::new();
+        let c2 = a.constant(2.0);
+        let c3 = a.constant(3.0);
+        let sum = a.add(c2, c3);
+        assert_eq!(a.as_const(sum), Some(5.0));
+        let product = a.mul(c2, c3);
+        assert_eq!(a.as_const(product), Some(6.0));
+        let zero = a.zero();
+        let s = a.sin(zero);
+        assert_eq!(a.as_const(s), Some(0.0));
+        let cube = a.powi(c2, 3);
+        assert_eq!(a.as_const(cube), Some(8.0));
+        let x = a.var(Var::T);
+        let three_x = a.mul(c3, x);
+        let six_x = a.mul(c2, three_x);
+        let six = a.constant(6.0);
+        assert_eq!(six_x, a.mul(six, x));
+    }
+
+    #[test]
+    fn non_finite_results_are_not_folded() {
+        let mut a = Arena::new();
+        let zero = a.zero();
+        let one = a.one();
+        let inf = a.div(one, zero);
+        assert_eq!(a.as_const(inf), None);
+        let ln0 = a.call(Func::Ln, zero);
+        assert_eq!(a.as_const(ln0), None);
+    }
+
+    #[test]
+    fn negative_zero_is_zero() {
+        let mut a = Arena::new();
+        let z = a.constant(-0.0);
+        assert_eq!(z, a.zero());
+    }
+
+    #[test]
+    fn variables_and_dependencies() {
+        let (mut a, x, y) = setup();
+        let t = a.var(Var::T);
+        let s = a.sin(x);
+        let e = a.mul(s, t);
+        assert_eq!(a.variables(e), vec![Var::Q(0), Var::T]);
+        assert!(a.depends_on(e, Var::T));
+        assert!(!a.depends_on(e, Var::Q(1)));
+        assert!(a.depends_on(y, Var::Q(1)));
+    }
+}

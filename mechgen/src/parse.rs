@@ -1,0 +1,488 @@
+//! Parsing: tokens (a `mechanism!` body or a `.mech` file) into a [`Spec`].
+//!
+//! The grammar, statement by statement (`//` comments and `///` doc comments as in Rust):
+//!
+//! ```text
+//! /// docs                                      carried onto the generated struct
+//! pub mechanism PistonCrank {
+//!     param omega = 314.0;                      run-time parameter with its default
+//!     ground liner at (156.8, 0, 0);            fixed body: pose (x, y, θ)
+//!     body piston near (130, 0, 0);             moving body: initial guess (x, y, θ)
+//!     joint pin: revolute(rod @ (41.3, 0), crank @ (0, 43));
+//!     joint slide: prismatic(liner, piston, along (1, 0));
+//!     joint link: distance(a @ (0, 10), b, 120);
+//!     driver crank: angle(crank) = omega * t;   also relative_angle(a, b), x(point),
+//! }                                              y(point), travel(prismatic_joint)
+//! ```
+//!
+//! A point is `body @ (x, y)` in the body's frame, or `body` alone for its reference point.
+//! Expressions use numbers, `t`, parameters, `+ - * /`, unary minus, `^` with an integer
+//! exponent, parentheses and `sin cos tan exp ln sqrt`. Only syntax is checked here.
+
+use proc_macro2::TokenStream;
+use syn::parse::{Parse, ParseStream};
+use syn::{Attribute, Ident, LitFloat, LitInt, Token, Visibility, braced, parenthesized};
+
+use crate::spec::{
+    BinOp, BodyDecl, DriverDecl, DriverKind, Expr, ExprKind, JointDecl, JointKind, ParamDecl,
+    PointRef, Spec,
+};
+
+mod kw {
+    syn::custom_keyword!(mechanism);
+    syn::custom_keyword!(param);
+    syn::custom_keyword!(ground);
+    syn::custom_keyword!(body);
+    syn::custom_keyword!(joint);
+    syn::custom_keyword!(driver);
+    syn::custom_keyword!(at);
+    syn::custom_keyword!(near);
+    syn::custom_keyword!(along);
+}
+
+/// Parses a `mechanism` declaration from tokens (the macro's input).
+///
+/// # Errors
+/// The first syntax error, at its tokens.
+pub fn parse_tokens(tokens: TokenStream) -> syn::Result<Spec> {
+    syn::parse2(tokens)
+}
+
+/// Parses a `mechanism` declaration from source text (a `.mech` file).
+///
+/// # Errors
+/// The first lexical or syntax error, with its position in the text.
+pub fn parse_str(source: &str) -> syn::Result<Spec> {
+    syn::parse_str(source)
+}
+
+impl Parse for Spec {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let docs = doc_attributes(input)?;
+        let vis: Visibility = input.parse()?;
+        input.parse::<kw::mechanism>().map_err(|e| {
+            syn::Error::new(
+                e.span(),
+                "expected `mechanism Name { … }` (optionally preceded by doc comments and `pub`)",
+            )
+        })?;
+        let name: Ident = input.parse()?;
+        let content;
+        braced!(content in input);
+        let mut spec = Spec {
+            docs,
+            vis,
+            name,
+            params: Vec::new(),
+            bodies: Vec::new(),
+            joints: Vec::new(),
+            drivers: Vec::new(),
+        };
+        while !content.is_empty() {
+            statement(&content, &mut spec)?;
+        }
+        if !input.is_empty() {
+            return Err(input.error("unexpected tokens after the mechanism's closing brace"));
+        }
+        Ok(spec)
+    }
+}
+
+/// Outer attributes, of which only doc comments are accepted.
+fn doc_attributes(input: ParseStream) -> syn::Result<Vec<Attribute>> {
+    let attrs = Attribute::parse_outer(input)?;
+    for attr in &attrs {
+        if !attr.path().is_ident("doc") {
+            return Err(syn::Error::new_spanned(
+                attr,
+                "only doc comments (`///`) are allowed here; remove this attribute",
+            ));
+        }
+    }
+    Ok(attrs)
+}
+
+fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> {
+    let docs = doc_attributes(input)?;
+    let look = input.lookahead1();
+    if look.peek(kw::param) {
+        input.parse::<kw::param>()?;
+        let name = input.parse()?;
+        input.parse::<Token![=]>()?;
+        let default = input.parse()?;
+        spec.params.push(ParamDecl {
+            docs,
+            name,
+            default,
+        });
+    } else if look.peek(kw::ground) || look.peek(kw::body) {
+        let ground = input.peek(kw::ground);
+        let keyword = input.span();
+        if ground {
+            input.parse::<kw::ground>()?;
+        } else {
+            input.parse::<kw::body>()?;
+        }
+        let name = input.parse()?;
+        if ground {
+            input.parse::<kw::at>().map_err(|e| {
+                syn::Error::new(e.span(), "expected `at (x, y, angle)`: the ground body's pose")
+            })?;
+        } else {
+            input.parse::<kw::near>().map_err(|e| {
+                syn::Error::new(e.span(), "expected `near (x, y, angle)`: an initial guess")
+            })?;
+        }
+        let pose = tuple::<3>(input)?;
+        spec.bodies.push(BodyDecl {
+            docs,
+            keyword,
+            name,
+            ground,
+            pose,
+        });
+    } else if look.peek(kw::joint) {
+        input.parse::<kw::joint>()?;
+        let name = input.parse()?;
+        input.parse::<Token![:]>()?;
+        let (kind_span, kind) = joint_kind(input)?;
+        spec.joints.push(JointDecl {
+            docs,
+            name,
+            kind_span,
+            kind,
+        });
+    } else if look.peek(kw::driver) {
+        input.parse::<kw::driver>()?;
+        let name = input.parse()?;
+        input.parse::<Token![:]>()?;
+        let (kind_span, kind) = driver_kind(input)?;
+        input.parse::<Token![=]>()?;
+        let value = input.parse()?;
+        spec.drivers.push(DriverDecl {
+            docs,
+            name,
+            kind_span,
+            kind,
+            value,
+        });
+    } else {
+        return Err(look.error());
+    }
+    input.parse::<Token![;]>()?;
+    Ok(())
+}
+
+fn joint_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, JointKind)> {
+    let kind: Ident = input.parse()?;
+    let args;
+    parenthesized!(args in input);
+    let a = args.parse()?;
+    args.parse::<Token![,]>()?;
+    let b = args.parse()?;
+    let joint = match kind.to_string().as_str() {
+        "revolute" => JointKind::Revolute { a, b },
+        "prismatic" => {
+            args.parse::<Token![,]>()?;
+            let axis_span = args.span();
+            args.parse::<kw::along>().map_err(|e| {
+                syn::Error::new(e.span(), "expected `along (ux, uy)`: the axis in the first body's frame")
+            })?;
+            let axis = tuple::<2>(&args)?;
+            JointKind::Prismatic {
+                a,
+                b,
+                axis,
+                axis_span,
+            }
+        }
+        "distance" => {
+            args.parse::<Token![,]>()?;
+            let length = args.parse()?;
+            JointKind::Distance { a, b, length }
+        }
+        other => {
+            return Err(syn::Error::new(
+                kind.span(),
+                format!(
+                    "unknown joint kind `{other}`; expected `revolute(a @ (x, y), b @ (x, y))`, \
+                     `prismatic(a, b, along (ux, uy))` or `distance(a, b, length)`"
+                ),
+            ));
+        }
+    };
+    if !args.is_empty() {
+        return Err(args.error("unexpected argument"));
+    }
+    Ok((kind.span(), joint))
+}
+
+fn driver_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, DriverKind)> {
+    let kind: Ident = input.parse()?;
+    let args;
+    parenthesized!(args in input);
+    let driver = match kind.to_string().as_str() {
+        "angle" => DriverKind::Angle(args.parse()?),
+        "relative_angle" => {
+            let a = args.parse()?;
+            args.parse::<Token![,]>()?;
+            DriverKind::RelativeAngle(a, args.parse()?)
+        }
+        "x" => DriverKind::X(args.parse()?),
+        "y" => DriverKind::Y(args.parse()?),
+        "travel" => DriverKind::Travel(args.parse()?),
+        other => {
+            return Err(syn::Error::new(
+                kind.span(),
+                format!(
+                    "unknown driver kind `{other}`; expected `angle(body)`, \
+                     `relative_angle(a, b)`, `x(body @ (x, y))`, `y(body @ (x, y))` or \
+                     `travel(prismatic_joint)`"
+                ),
+            ));
+        }
+    };
+    if !args.is_empty() {
+        return Err(args.error("unexpected argument"));
+    }
+    Ok((kind.span(), driver))
+}
+
+impl Parse for PointRef {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let body = input.parse()?;
+        let local = if input.peek(Token![@]) {
+            input.parse::<Token![@]>()?;
+            Some(tuple::<2>(input)?)
+        } else {
+            None
+        };
+        Ok(PointRef { body, local })
+    }
+}
+
+/// `(e1, …, eN)` with exactly N expressions.
+fn tuple<const N: usize>(input: ParseStream) -> syn::Result<[Expr; N]> {
+    let content;
+    let paren = parenthesized!(content in input);
+    let mut items = Vec::with_capacity(N);
+    while !content.is_empty() {
+        items.push(content.parse::<Expr>()?);
+        if content.is_empty() {
+            break;
+        }
+        content.parse::<Token![,]>()?;
+    }
+    let found = items.len();
+    items.try_into().map_err(|_| {
+        syn::Error::new(
+            paren.span.join(),
+            format!("expected {N} comma-separated values, found {found}"),
+        )
+    })
+}
+
+impl Parse for Expr {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        binary(input, 0)
+    }
+}
+
+/// Precedence climbing over `+ -` (1) and `* /` (2), left-associative.
+fn binary(input: ParseStream, min_prec: u8) -> syn::Result<Expr> {
+    let mut lhs = unary(input)?;
+    loop {
+        let (op, prec) = if input.peek(Token![+]) {
+            (BinOp::Add, 1)
+        } else if input.peek(Token![-]) {
+            (BinOp::Sub, 1)
+        } else if input.peek(Token![*]) {
+            (BinOp::Mul, 2)
+        } else if input.peek(Token![/]) {
+            (BinOp::Div, 2)
+        } else {
+            return Ok(lhs);
+        };
+        if prec < min_prec {
+            return Ok(lhs);
+        }
+        let span = input.span();
+        input.parse::<proc_macro2::Punct>()?;
+        let rhs = binary(input, prec + 1)?;
+        lhs = Expr {
+            span,
+            kind: ExprKind::Binary(op, Box::new(lhs), Box::new(rhs)),
+        };
+    }
+}
+
+/// Unary minus binds looser than `^`: `-x^2` is `-(x^2)`.
+fn unary(input: ParseStream) -> syn::Result<Expr> {
+    if input.peek(Token![-]) {
+        let span = input.span();
+        input.parse::<Token![-]>()?;
+        let operand = unary(input)?;
+        return Ok(Expr {
+            span,
+            kind: ExprKind::Neg(Box::new(operand)),
+        });
+    }
+    power(input)
+}
+
+fn power(input: ParseStream) -> syn::Result<Expr> {
+    let base = atom(input)?;
+    if !input.peek(Token![^]) {
+        return Ok(base);
+    }
+    let span = input.span();
+    input.parse::<Token![^]>()?;
+    let negative = input.parse::<Option<Token![-]>>()?.is_some();
+    let exponent: LitInt = input.parse().map_err(|e| {
+        syn::Error::new(e.span(), "`^` takes an integer exponent, such as `t^2` or `x^-1`")
+    })?;
+    let magnitude: i32 = exponent.base10_parse()?;
+    let n = if negative { -magnitude } else { magnitude };
+    Ok(Expr {
+        span,
+        kind: ExprKind::Pow(Box::new(base), n),
+    })
+}
+
+fn atom(input: ParseStream) -> syn::Result<Expr> {
+    let span = input.span();
+    if input.peek(syn::token::Paren) {
+        let content;
+        parenthesized!(content in input);
+        let inner: Expr = content.parse()?;
+        if !content.is_empty() {
+            return Err(content.error("expected `)` after the expression"));
+        }
+        return Ok(inner);
+    }
+    if input.peek(LitFloat) {
+        let lit: LitFloat = input.parse()?;
+        return number(lit.base10_digits(), lit.suffix(), span);
+    }
+    if input.peek(LitInt) {
+        let lit: LitInt = input.parse()?;
+        return number(lit.base10_digits(), lit.suffix(), span);
+    }
+    if input.peek(Ident) {
+        let name: Ident = input.parse()?;
+        if input.peek(syn::token::Paren) {
+            let content;
+            parenthesized!(content in input);
+            let arg: Expr = content.parse()?;
+            if !content.is_empty() {
+                return Err(content.error("functions take one argument"));
+            }
+            return Ok(Expr {
+                span,
+                kind: ExprKind::Call(name, Box::new(arg)),
+            });
+        }
+        return Ok(Expr {
+            span,
+            kind: ExprKind::Name(name),
+        });
+    }
+    Err(input.error("expected a number, `t`, a parameter, a function call or `(`"))
+}
+
+fn number(digits: &str, suffix: &str, span: proc_macro2::Span) -> syn::Result<Expr> {
+    if !suffix.is_empty() {
+        return Err(syn::Error::new(
+            span,
+            format!("remove the `{suffix}` suffix: every number is an f64"),
+        ));
+    }
+    let value: f64 = digits
+        .parse()
+        .map_err(|_| syn::Error::new(span, "not a valid number"))?;
+    if !value.is_finite() {
+        return Err(syn::Error::new(span, "number is too large for an f64"));
+    }
+    Ok(Expr {
+        span,
+        kind: ExprKind::Number(value),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn show(e: &Expr) -> String {
+        match &e.kind {
+            ExprKind::Number(v) => format!("{v}"),
+            ExprKind::Name(n) => n.to_string(),
+            ExprKind::Neg(a) => format!("(-{})", show(a)),
+            ExprKind::Binary(op, a, b) => {
+                let op = match op {
+                    BinOp::Add => "+",
+                    BinOp::Sub => "-",
+                    BinOp::Mul => "*",
+                    BinOp::Div => "/",
+                };
+                format!("({} {op} {})", show(a), show(b))
+            }
+            ExprKind::Pow(a, n) => format!("({}^{n})", show(a)),
+            ExprKind::Call(f, a) => format!("{f}({})", show(a)),
+        }
+    }
+
+    fn expr(s: &str) -> String {
+        show(&syn::parse_str::<Expr>(s).ok().expect("parses"))
+    }
+
+    #[test]
+    fn precedence_and_associativity() {
+        assert_eq!(expr("1 + 2 * t"), "(1 + (2 * t))");
+        assert_eq!(expr("a - b - c"), "((a - b) - c)");
+        assert_eq!(expr("a / b * c"), "((a / b) * c)");
+        assert_eq!(expr("-t^2"), "(-(t^2))");
+        assert_eq!(expr("(1 + t) * 2"), "((1 + t) * 2)");
+        assert_eq!(expr("0.5 * sin(2000 * t)"), "(0.5 * sin((2000 * t)))");
+        assert_eq!(expr("x^-1"), "(x^-1)");
+        assert_eq!(expr("1e-6"), "0.000001");
+    }
+
+    #[test]
+    fn parses_the_seed() {
+        let spec = parse_str(
+            "/// Seed.\npub mechanism PistonCrank {
+                param omega = 314;
+                ground liner at (156.8, 0, 0);
+                body piston near (130, 0, 0);
+                body crank near (0, 0, 0);
+                joint pin: revolute(piston @ (-28, 0), crank @ (0, 43));
+                joint slide: prismatic(liner, piston, along (1, 0));
+                joint link: distance(liner, crank, 10);
+                driver spin: angle(crank) = omega * t;
+            }",
+        )
+        .ok()
+        .expect("parses");
+        assert_eq!(spec.name, "PistonCrank");
+        assert_eq!(spec.docs.len(), 1);
+        assert_eq!(spec.params.len(), 1);
+        assert_eq!(spec.bodies.len(), 3);
+        assert!(spec.bodies[0].ground && !spec.bodies[1].ground);
+        assert_eq!(spec.joints.len(), 3);
+        assert_eq!(spec.drivers.len(), 1);
+        assert!(matches!(spec.joints[1].kind, JointKind::Prismatic { .. }));
+    }
+
+    #[test]
+    fn syntax_errors_say_what_was_expected() {
+        let err = |s: &str| parse_str(s).err().expect("an error").to_string();
+        assert!(err("mechanism M { joint j: hinge(a, b); }").contains("unknown joint kind `hinge`"));
+        assert!(err("mechanism M { body b at (0, 0, 0); }").contains("near (x, y, angle)"));
+        assert!(err("mechanism M { body b near (0, 0); }").contains("expected 3"));
+        assert!(err("mechanism M { param p = 1f32; }").contains("suffix"));
+        assert!(err("mechanism M { param p = t^x; }").contains("integer exponent"));
+        assert!(err("#[derive(Debug)] mechanism M {}").contains("only doc comments"));
+        assert!(err("struct M {}").contains("mechanism Name"));
+    }
+}

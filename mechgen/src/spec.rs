@@ -1,0 +1,175 @@
+//! The spec: what the user wrote, as parsed, with every name and value still carrying its span.
+//!
+//! Nothing here is resolved or validated beyond syntax; `check` turns a [`Spec`] into a model.
+
+use proc_macro2::Span;
+use syn::{Attribute, Ident, Visibility};
+
+/// A whole `mechanism` declaration.
+#[derive(Clone)]
+pub struct Spec {
+    /// Outer doc comments, carried onto the generated struct.
+    pub docs: Vec<Attribute>,
+    /// Visibility of the generated items.
+    pub vis: Visibility,
+    /// Name of the generated struct (UpperCamelCase).
+    pub name: Ident,
+    /// Run-time parameters with their defaults.
+    pub params: Vec<ParamDecl>,
+    /// Bodies in declaration order (this is the order of q).
+    pub bodies: Vec<BodyDecl>,
+    /// Joints in declaration order.
+    pub joints: Vec<JointDecl>,
+    /// Drivers in declaration order.
+    pub drivers: Vec<DriverDecl>,
+}
+
+/// `param omega = 314.0;`
+#[derive(Clone)]
+pub struct ParamDecl {
+    /// Doc comments, carried onto the generated field.
+    pub docs: Vec<Attribute>,
+    /// Name (a snake_case field of the generated struct).
+    pub name: Ident,
+    /// Default value (a constant expression).
+    pub default: Expr,
+}
+
+/// `ground liner at (x, y, θ);` or `body piston near (x, y, θ);`
+#[derive(Clone)]
+pub struct BodyDecl {
+    /// Doc comments, carried onto the generated accessor.
+    pub docs: Vec<Attribute>,
+    /// Span of the `ground` / `body` keyword.
+    pub keyword: Span,
+    /// Name of the body.
+    pub name: Ident,
+    /// True for `ground` (pose fixed by three equations), false for a moving `body`.
+    pub ground: bool,
+    /// Pose of a ground body, or the initial guess of a moving one.
+    pub pose: [Expr; 3],
+}
+
+/// A body-fixed point: `rod @ (41.3, 0)`, or `rod` alone for its reference point.
+#[derive(Clone)]
+pub struct PointRef {
+    /// The body the point is fixed to.
+    pub body: Ident,
+    /// Body-frame coordinates; `None` for the origin.
+    pub local: Option<[Expr; 2]>,
+}
+
+/// `joint NAME: KIND(...);`
+#[derive(Clone)]
+pub struct JointDecl {
+    /// Doc comments.
+    pub docs: Vec<Attribute>,
+    /// Name of the joint (names its equations, e.g. `crank_pin.x`).
+    pub name: Ident,
+    /// Span of the joint kind (`revolute`, …).
+    pub kind_span: Span,
+    /// The joint.
+    pub kind: JointKind,
+}
+
+/// The joints of the library; each is only its Φ, everything else is derived.
+#[derive(Clone)]
+pub enum JointKind {
+    /// `revolute(a @ s_a, b @ s_b)`: the two points coincide (2 equations).
+    Revolute {
+        /// Point on the first body.
+        a: PointRef,
+        /// Point on the second body.
+        b: PointRef,
+    },
+    /// `prismatic(a @ p_a, b @ p_b, along (ux, uy))`: `b`'s point stays on the line through
+    /// `a`'s point along `a`-fixed direction u, with no relative rotation (2 equations).
+    Prismatic {
+        /// Point on the guiding body.
+        a: PointRef,
+        /// Point on the sliding body.
+        b: PointRef,
+        /// Axis direction in the guiding body's frame.
+        axis: [Expr; 2],
+        /// Span of the axis, for diagnostics.
+        axis_span: Span,
+    },
+    /// `distance(a @ s_a, b @ s_b, L)`: the points stay L apart (1 equation).
+    Distance {
+        /// Point on the first body.
+        a: PointRef,
+        /// Point on the second body.
+        b: PointRef,
+        /// The distance.
+        length: Expr,
+    },
+}
+
+/// `driver NAME: KIND(...) = f(t);`
+#[derive(Clone)]
+pub struct DriverDecl {
+    /// Doc comments.
+    pub docs: Vec<Attribute>,
+    /// Name of the driver (names its equation).
+    pub name: Ident,
+    /// Span of the driver kind, for diagnostics.
+    pub kind_span: Span,
+    /// What is driven.
+    pub kind: DriverKind,
+    /// The prescribed value as a function of t and parameters.
+    pub value: Expr,
+}
+
+/// What a driver prescribes.
+#[derive(Clone)]
+pub enum DriverKind {
+    /// `angle(body)`: θ_body.
+    Angle(Ident),
+    /// `relative_angle(a, b)`: θ_b − θ_a.
+    RelativeAngle(Ident, Ident),
+    /// `x(point)`: global x of a body-fixed point.
+    X(PointRef),
+    /// `y(point)`: global y of a body-fixed point.
+    Y(PointRef),
+    /// `travel(joint)`: position of a prismatic joint's slider along its axis.
+    Travel(Ident),
+}
+
+/// An expression as written, in `t`, parameters and numbers.
+#[derive(Clone)]
+pub struct Expr {
+    /// Where it was written.
+    pub span: Span,
+    /// What it is.
+    pub kind: ExprKind,
+}
+
+/// The forms of [`Expr`].
+#[derive(Clone)]
+pub enum ExprKind {
+    /// A numeric literal.
+    Number(f64),
+    /// `t` or a parameter name.
+    Name(Ident),
+    /// `-a`
+    Neg(Box<Expr>),
+    /// `a op b`
+    Binary(BinOp, Box<Expr>, Box<Expr>),
+    /// `a ^ n` with an integer literal n.
+    Pow(Box<Expr>, i32),
+    /// `f(a)`
+    Call(Ident, Box<Expr>),
+}
+
+/// Binary operators.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BinOp {
+    /// `+`
+    Add,
+    /// `-`
+    Sub,
+    /// `*`
+    Mul,
+    /// `/`
+    Div,
+}

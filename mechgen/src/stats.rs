@@ -1,0 +1,65 @@
+//! Operation counts of generated code, so that a regression in what a function computes shows up
+//! in review (doc comments and snapshots) rather than only in a benchmark.
+
+use std::fmt;
+
+use crate::expr::{Arena, Func, Id, Node};
+
+/// How many operations of each kind a straight-line evaluation performs (each DAG node once).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct OpCounts {
+    /// sin, cos, tan calls.
+    pub trig: usize,
+    /// sqrt calls.
+    pub sqrt: usize,
+    /// exp and ln calls.
+    pub exp_ln: usize,
+    /// Multiplications (an integer power counts as its multiplications).
+    pub mul: usize,
+    /// Additions and subtractions.
+    pub add: usize,
+    /// Divisions.
+    pub div: usize,
+    /// Negations.
+    pub neg: usize,
+}
+
+impl OpCounts {
+    /// Counts the operations of the nodes in `order` (each evaluated once).
+    pub fn of(arena: &Arena, order: &[Id]) -> Self {
+        let mut c = OpCounts::default();
+        for &id in order {
+            match arena.node(id) {
+                Node::Const(_) | Node::Param(_) | Node::Var(_) => {}
+                Node::Neg(_) => c.neg += 1,
+                Node::Add(..) | Node::Sub(..) => c.add += 1,
+                Node::Mul(..) => c.mul += 1,
+                Node::Div(..) => c.div += 1,
+                Node::Powi(_, n) => {
+                    // Repeated squaring: ⌊log2 n⌋ squarings plus one product per extra set bit.
+                    let e = n.unsigned_abs();
+                    c.mul += (31 - e.leading_zeros()) as usize + e.count_ones() as usize - 1;
+                    if n < 0 {
+                        c.div += 1;
+                    }
+                }
+                Node::Call(f, _) => match f {
+                    Func::Sin | Func::Cos | Func::Tan => c.trig += 1,
+                    Func::Sqrt => c.sqrt += 1,
+                    Func::Exp | Func::Ln => c.exp_ln += 1,
+                },
+            }
+        }
+        c
+    }
+}
+
+impl fmt::Display for OpCounts {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} trig, {} sqrt, {} exp/ln, {} mul, {} add, {} div, {} neg",
+            self.trig, self.sqrt, self.exp_ln, self.mul, self.add, self.div, self.neg
+        )
+    }
+}
