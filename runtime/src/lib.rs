@@ -4,15 +4,36 @@
 //! matrices on the stack, so every solve path (positions, velocities, accelerations, stepping)
 //! runs without a heap. The `alloc` feature adds dynamically sized mechanisms (used by the
 //! interpreter behind the `mechgen` CLI), which allocate once when the solver is built.
+//!
+//! [`Solver`] solves one instant ([`Solver::solve`]); [`Simulation`] steps through time with a
+//! warm-started predictor. Failures are [`SolveError`]s; [`SolveError::describe`] names the
+//! equations and coordinates involved. [`State::write_csv_row`] writes results without a heap.
 #![no_std]
+// The runtime must build without std or alloc: catch `std::` paths that `core::` provides.
+#![warn(clippy::std_instead_of_core, clippy::alloc_instead_of_core)]
 
 #[cfg(feature = "alloc")]
 extern crate alloc;
+// Unit tests format into `String`s.
+#[cfg(test)]
+extern crate std;
 
+mod error;
+mod lu;
 pub mod math;
 mod mechanism;
+#[cfg(test)]
+mod pendulum;
+mod simulate;
+mod solver;
+mod state;
 
+pub use error::{Described, Quantity, SolveError};
+pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use mechanism::{Matrix, Mechanism, ParameterError, Storage, Vector};
+pub use simulate::Simulation;
+pub use solver::{Convergence, Solver, SolverOptions};
+pub use state::{BodyState, State, write_csv_header};
 
 /// Re-exported so generated code and users name one crate.
 pub use nalgebra;

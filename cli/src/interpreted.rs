@@ -1,0 +1,210 @@
+//! A compiled scene evaluated by the interpreter, behind the runtime's `Mechanism` trait.
+//!
+//! This is what a run-time (non-generated) library would do: the same IR as the generated code,
+//! walked at run time. It lets the CLI, the tests and the report drive the one solver
+//! implementation of `mechgen-runtime` with scenes read from `.mech` files.
+
+use std::cell::RefCell;
+
+use mechgen::Scene;
+use mechgen::interpret::{Inputs, Tape};
+use mechgen_runtime::nalgebra::Dyn;
+use mechgen_runtime::{Matrix, Mechanism, ParameterError, Vector};
+
+/// A scene whose kinematics are interpreted rather than generated.
+#[derive(Debug, Clone)]
+pub struct Interpreted {
+    name: String,
+    coordinates: Vec<String>,
+    equations: Vec<String>,
+    param_names: Vec<String>,
+    params: Vec<f64>,
+    guess: Tape,
+    phi: Tape,
+    jacobian: Tape,
+    phi_and_jacobian: Tape,
+    nu: Tape,
+    gamma: Tape,
+    /// Structural non-zeros of Φ_q, in the order the Jacobian tape produces them.
+    pattern: Vec<(usize, usize)>,
+    /// Tape slots and output values, reused by every call (evaluation is `&self`).
+    scratch: RefCell<Scratch>,
+}
+
+#[derive(Debug, Clone, Default)]
+struct Scratch {
+    slots: Vec<f64>,
+    values: Vec<f64>,
+}
+
+impl Interpreted {
+    /// Builds the interpreter for a compiled scene (parameters start at their defaults).
+    pub fn new(scene: &Scene) -> Self {
+        let (model, kin) = (&scene.model, &scene.kinematics);
+        let arena = &model.arena;
+        let jacobian_values: Vec<_> = kin.jacobian.iter().map(|e| e.value).collect();
+        let both: Vec<_> = kin.phi.iter().copied().chain(jacobian_values.iter().copied()).collect();
+        let tapes = [
+            Tape::new(arena, &kin.guess),
+            Tape::new(arena, &kin.phi),
+            Tape::new(arena, &jacobian_values),
+            Tape::new(arena, &both),
+            Tape::new(arena, &kin.nu),
+            Tape::new(arena, &kin.gamma),
+        ];
+        let slots = tapes.iter().map(Tape::len).max().unwrap_or(0);
+        let values = both.len().max(model.dim());
+        let [guess, phi, jacobian, phi_and_jacobian, nu, gamma] = tapes;
+        Interpreted {
+            name: model.name.to_string(),
+            coordinates: model.coordinate_names(),
+            equations: model.equation_names(),
+            param_names: model.params.iter().map(|p| p.name.to_string()).collect(),
+            params: model.params.iter().map(|p| p.default).collect(),
+            guess,
+            phi,
+            jacobian,
+            phi_and_jacobian,
+            nu,
+            gamma,
+            pattern: kin.jacobian.iter().map(|e| (e.row, e.col)).collect(),
+            scratch: RefCell::new(Scratch {
+                slots: vec![0.0; slots],
+                values: vec![0.0; values],
+            }),
+        }
+    }
+
+    /// The mechanism's name as declared.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Number of coordinates (= equations).
+    pub fn len(&self) -> usize {
+        self.coordinates.len()
+    }
+
+    /// True for a scene without coordinates (never produced by a checked model).
+    pub fn is_empty(&self) -> bool {
+        self.coordinates.is_empty()
+    }
+
+    /// Structural non-zeros of Φ_q as (equation, coordinate).
+    pub fn jacobian_pattern(&self) -> &[(usize, usize)] {
+        &self.pattern
+    }
+
+    fn run(&self, tape: &Tape, inputs: Inputs<'_>, write: impl FnOnce(&[f64])) {
+        let mut scratch = self.scratch.borrow_mut();
+        let Scratch { slots, values } = &mut *scratch;
+        tape.eval(inputs, slots, values);
+        write(values);
+    }
+
+    fn inputs<'a>(&'a self, q: &'a [f64], qd: &'a [f64], t: f64) -> Inputs<'a> {
+        Inputs {
+            q,
+            qd,
+            t,
+            params: &self.params,
+        }
+    }
+
+    fn write_jacobian(&self, values: &[f64], out: &mut Matrix<Dyn>) {
+        out.fill(0.0);
+        for (&(row, col), &value) in self.pattern.iter().zip(values) {
+            out[(row, col)] = value;
+        }
+    }
+}
+
+fn copy_into(values: &[f64], out: &mut Vector<Dyn>) {
+    for (o, v) in out.iter_mut().zip(values) {
+        *o = *v;
+    }
+}
+
+impl Mechanism for Interpreted {
+    type Dim = Dyn;
+
+    fn dim(&self) -> Dyn {
+        Dyn(self.coordinates.len())
+    }
+
+    fn coordinate_name(&self, index: usize) -> Option<&str> {
+        self.coordinates.get(index).map(String::as_str)
+    }
+
+    fn equation_name(&self, index: usize) -> Option<&str> {
+        self.equations.get(index).map(String::as_str)
+    }
+
+    fn parameter_count(&self) -> usize {
+        self.params.len()
+    }
+
+    fn parameter_name(&self, index: usize) -> Option<&str> {
+        self.param_names.get(index).map(String::as_str)
+    }
+
+    fn parameter(&self, index: usize) -> Option<f64> {
+        self.params.get(index).copied()
+    }
+
+    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParameterError> {
+        if !value.is_finite() {
+            return Err(ParameterError::NonFinite);
+        }
+        let index = self
+            .param_names
+            .iter()
+            .position(|p| p == name)
+            .ok_or(ParameterError::Unknown)?;
+        self.params[index] = value;
+        Ok(())
+    }
+
+    fn initial_guess(&self, q: &mut Vector<Dyn>) {
+        self.run(&self.guess, self.inputs(&[], &[], 0.0), |v| copy_into(v, q));
+    }
+
+    fn phi(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
+        self.run(&self.phi, self.inputs(q.as_slice(), &[], t), |v| {
+            copy_into(v, out);
+        });
+    }
+
+    fn jacobian(&self, q: &Vector<Dyn>, t: f64, out: &mut Matrix<Dyn>) {
+        self.run(&self.jacobian, self.inputs(q.as_slice(), &[], t), |v| {
+            self.write_jacobian(v, out);
+        });
+    }
+
+    fn phi_and_jacobian(
+        &self,
+        q: &Vector<Dyn>,
+        t: f64,
+        phi: &mut Vector<Dyn>,
+        jacobian: &mut Matrix<Dyn>,
+    ) {
+        let n = self.coordinates.len();
+        self.run(&self.phi_and_jacobian, self.inputs(q.as_slice(), &[], t), |v| {
+            let (phi_values, jacobian_values) = v.split_at(n.min(v.len()));
+            copy_into(phi_values, phi);
+            self.write_jacobian(jacobian_values, jacobian);
+        });
+    }
+
+    fn nu(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
+        self.run(&self.nu, self.inputs(q.as_slice(), &[], t), |v| copy_into(v, out));
+    }
+
+    fn gamma(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
+        self.run(
+            &self.gamma,
+            self.inputs(q.as_slice(), qd.as_slice(), t),
+            |v| copy_into(v, out),
+        );
+    }
+}

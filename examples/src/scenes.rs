@@ -1,0 +1,59 @@
+//! The example scenes, declared with `mechanism!`. Each has a `.mech` twin in `scenes/` for the
+//! CLI; a test holds the two to the same tokens.
+
+use mechgen_runtime::mechanism;
+
+mechanism! {
+    /// Piston-crank of a boxer engine: the seed mechanism (5 bodies, 15 coordinates, mm, rad, s).
+    ///
+    /// The crank turns at `omega`; the connecting rod drives the piston along the liner's x axis.
+    pub mechanism PistonCrank {
+        /// Crank speed (rad/s).
+        param omega = 314.0;
+
+        /// Cylinder liner (fixed).
+        ground liner at (156.8, 0, 0);
+        /// Piston, sliding in the liner.
+        body piston near (130, 0, 0);
+        /// Connecting rod.
+        body rod near (29, 72, -2.35);
+        /// Crank shaft.
+        body crank near (0, 0, 0);
+        /// Crank bearing (fixed).
+        ground bearing at (0, 0, 0);
+
+        joint crank_pin: revolute(rod @ (41.3, 0), crank @ (0, 43));
+        joint piston_pin: revolute(piston @ (-28, 0), rod @ (0, 102.6));
+        joint main_bearing: revolute(crank, bearing);
+        joint slide: prismatic(liner, piston, along (1, 0));
+
+        driver crank_angle: angle(crank) = omega * t;
+    }
+}
+
+mechanism! {
+    /// Crank-rocker four-bar (Grashof: 40 + 120 < 80 + 100), units mm, rad, s.
+    ///
+    /// The crank turns fully at `omega`; the rocker swings. Coupler and rocker start on the open
+    /// branch (coupler pin above the line from crank pin to rocker pivot).
+    pub mechanism FourBar {
+        /// Crank speed (rad/s).
+        param omega = 10.0;
+
+        /// Frame (fixed), with the crank pivot at its origin and the rocker pivot at (100, 0).
+        ground frame at (0, 0, 0);
+        /// Crank, 40 long, pivoting at its reference point.
+        body crank near (0, 0, 0);
+        /// Coupler, 120 long, with its reference point at the crank pin.
+        body coupler near (40, 0, 0.6);
+        /// Rocker, 80 long, pivoting at its reference point.
+        body rocker near (100, 0, 1.1);
+
+        joint crank_pivot: revolute(frame, crank);
+        joint crank_pin: revolute(crank @ (40, 0), coupler);
+        joint rocker_pin: revolute(coupler @ (120, 0), rocker @ (80, 0));
+        joint rocker_pivot: revolute(rocker, frame @ (100, 0));
+
+        driver crank_angle: angle(crank) = omega * t;
+    }
+}

@@ -1,0 +1,176 @@
+//! A hand-written driven pendulum, the smallest mechanism the unit tests solve.
+//!
+//! One body, pinned at the origin at distance `a` from its reference point, its angle driven as
+//! `θ = ω t`: `x = a cos θ`, `y = a sin θ`. `duplicate_pin` replaces the driver with a copy of the
+//! first pin equation to make Φ_q singular on purpose.
+
+use nalgebra::Const;
+
+use crate::math::{cos, sin};
+use crate::mechanism::{Matrix, Mechanism, ParameterError, Vector};
+
+#[derive(Debug, Clone)]
+pub struct Pendulum {
+    pub a: f64,
+    pub omega: f64,
+    pub duplicate_pin: bool,
+}
+
+impl Default for Pendulum {
+    fn default() -> Self {
+        Self {
+            a: 2.0,
+            omega: 1.5,
+            duplicate_pin: false,
+        }
+    }
+}
+
+impl Pendulum {
+    /// Closed-form `(q, q̇, q̈)` at `t`.
+    pub fn exact(&self, t: f64) -> [[f64; 3]; 3] {
+        let (a, w) = (self.a, self.omega);
+        let (s, c) = (sin(w * t), cos(w * t));
+        [
+            [a * c, a * s, w * t],
+            [-a * w * s, a * w * c, w],
+            [-a * w * w * c, -a * w * w * s, 0.0],
+        ]
+    }
+}
+
+const COORDINATES: [&str; 3] = ["rod.x", "rod.y", "rod.theta"];
+const EQUATIONS: [&str; 3] = ["pin.x", "pin.y", "drive"];
+
+impl Mechanism for Pendulum {
+    type Dim = Const<3>;
+
+    fn dim(&self) -> Const<3> {
+        Const
+    }
+    fn coordinate_name(&self, index: usize) -> Option<&str> {
+        COORDINATES.get(index).copied()
+    }
+    fn equation_name(&self, index: usize) -> Option<&str> {
+        EQUATIONS.get(index).copied()
+    }
+    fn parameter_count(&self) -> usize {
+        0
+    }
+    fn parameter_name(&self, _: usize) -> Option<&str> {
+        None
+    }
+    fn parameter(&self, _: usize) -> Option<f64> {
+        None
+    }
+    fn set_parameter(&mut self, _: &str, _: f64) -> Result<(), ParameterError> {
+        Err(ParameterError::Unknown)
+    }
+    fn initial_guess(&self, q: &mut Vector<Const<3>>) {
+        *q = Vector::from([self.a, 0.1, 0.1]);
+    }
+    fn phi(&self, q: &Vector<Const<3>>, t: f64, out: &mut Vector<Const<3>>) {
+        let (x, y, th) = (q.x, q.y, q.z);
+        let pin_x = x - self.a * cos(th);
+        let third = if self.duplicate_pin {
+            pin_x
+        } else {
+            th - self.omega * t
+        };
+        *out = Vector::from([pin_x, y - self.a * sin(th), third]);
+    }
+    fn jacobian(&self, q: &Vector<Const<3>>, _: f64, out: &mut Matrix<Const<3>>) {
+        let th = q.z;
+        let (s, c) = (self.a * sin(th), self.a * cos(th));
+        let third = if self.duplicate_pin {
+            [1.0, 0.0, s]
+        } else {
+            [0.0, 0.0, 1.0]
+        };
+        *out = Matrix::<Const<3>>::from_row_slice(&[
+            1.0, 0.0, s, //
+            0.0, 1.0, -c, //
+            third[0], third[1], third[2],
+        ]);
+    }
+    fn nu(&self, _: &Vector<Const<3>>, _: f64, out: &mut Vector<Const<3>>) {
+        *out = Vector::from([0.0, 0.0, self.omega]);
+    }
+    fn gamma(
+        &self,
+        q: &Vector<Const<3>>,
+        qd: &Vector<Const<3>>,
+        _: f64,
+        out: &mut Vector<Const<3>>,
+    ) {
+        let (th, thd) = (q.z, qd.z);
+        let w2 = thd * thd;
+        *out = Vector::from([-self.a * cos(th) * w2, -self.a * sin(th) * w2, 0.0]);
+    }
+}
+
+/// The same pendulum behind a `Dyn` dimension, as the interpreter would present it.
+#[cfg(feature = "alloc")]
+pub struct DynPendulum(pub Pendulum);
+
+#[cfg(feature = "alloc")]
+mod dynamic {
+    use super::{DynPendulum, Mechanism, ParameterError, Vector};
+    use crate::mechanism::Matrix;
+    use nalgebra::{Const, Dyn, Matrix3, Vector3};
+
+    fn fixed(v: &Vector<Dyn>) -> Vector3<f64> {
+        Vector3::from_iterator(v.iter().copied())
+    }
+
+    impl Mechanism for DynPendulum {
+        type Dim = Dyn;
+
+        fn dim(&self) -> Dyn {
+            Dyn(3)
+        }
+        fn coordinate_name(&self, index: usize) -> Option<&str> {
+            self.0.coordinate_name(index)
+        }
+        fn equation_name(&self, index: usize) -> Option<&str> {
+            self.0.equation_name(index)
+        }
+        fn parameter_count(&self) -> usize {
+            0
+        }
+        fn parameter_name(&self, _: usize) -> Option<&str> {
+            None
+        }
+        fn parameter(&self, _: usize) -> Option<f64> {
+            None
+        }
+        fn set_parameter(&mut self, _: &str, _: f64) -> Result<(), ParameterError> {
+            Err(ParameterError::Unknown)
+        }
+        fn initial_guess(&self, q: &mut Vector<Dyn>) {
+            let mut fixed_q = Vector3::zeros();
+            self.0.initial_guess(&mut fixed_q);
+            q.copy_from_slice(fixed_q.as_slice());
+        }
+        fn phi(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
+            let mut phi = Vector::<Const<3>>::zeros();
+            self.0.phi(&fixed(q), t, &mut phi);
+            out.copy_from_slice(phi.as_slice());
+        }
+        fn jacobian(&self, q: &Vector<Dyn>, t: f64, out: &mut Matrix<Dyn>) {
+            let mut jacobian = Matrix3::zeros();
+            self.0.jacobian(&fixed(q), t, &mut jacobian);
+            out.copy_from(&jacobian);
+        }
+        fn nu(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
+            let mut nu = Vector3::zeros();
+            self.0.nu(&fixed(q), t, &mut nu);
+            out.copy_from_slice(nu.as_slice());
+        }
+        fn gamma(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
+            let mut gamma = Vector3::zeros();
+            self.0.gamma(&fixed(q), &fixed(qd), t, &mut gamma);
+            out.copy_from_slice(gamma.as_slice());
+        }
+    }
+}
