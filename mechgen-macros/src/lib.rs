@@ -5,7 +5,7 @@ use proc_macro::TokenStream;
 
 /// Declares a planar mechanism and generates its kinematics (Φ, Φ_q, ν, γ) as straight-line Rust.
 ///
-/// The grammar is documented in the `mechgen` crate (`mechgen::grammar`).
+/// The grammar is documented in `mechgen::parse`; errors are reported at the offending tokens.
 #[proc_macro]
 pub fn mechanism(input: TokenStream) -> TokenStream {
     mechgen::expand_or_errors(input.into()).into()

@@ -66,7 +66,7 @@ pub fn check(spec: &Spec) -> Result<Model, Errors> {
         })
         .collect();
     for joint in &spec.joints {
-        if let Some(kind) = cx.joint(&joint.name, joint.kind_span, &joint.kind) {
+        if let Some(kind) = cx.joint(&joint.name, &joint.kind) {
             constraints.push(Constraint {
                 name: joint.name.to_string(),
                 kind,
@@ -83,7 +83,11 @@ pub fn check(spec: &Spec) -> Result<Model, Errors> {
             });
         }
     }
-    cx.check_mobility(spec);
+    // A rejected joint or driver would make the degree-of-freedom count misleading: count only a
+    // scene whose parts all checked.
+    if cx.errors.is_empty() {
+        cx.check_mobility(spec);
+    }
     cx.errors.finish()?;
     Ok(Model {
         docs: spec.docs.clone(),
@@ -162,10 +166,15 @@ impl Checker {
                 v.sort_by_key(|(_, i)| **i);
                 v.into_iter().map(|(n, _)| format!("`{n}`")).collect()
             };
+            let candidates = self.bodies.keys().map(String::as_str);
+            let hint = match did_you_mean(&name.to_string(), candidates) {
+                Some(close) => format!("did you mean `{close}`? "),
+                None => String::new(),
+            };
             self.errors.push(
                 name.span(),
                 format!(
-                    "unknown body `{name}`; declared bodies are {}",
+                    "unknown body `{name}`; {hint}declared bodies are {}",
                     if known.is_empty() {
                         "none".to_owned()
                     } else {
@@ -186,7 +195,7 @@ impl Checker {
         Some(Point { body, local })
     }
 
-    fn two_points(&mut self, a: &PointRef, b: &PointRef, span: Span) -> Option<(Point, Point)> {
+    fn two_points(&mut self, a: &PointRef, b: &PointRef) -> Option<(Point, Point)> {
         let (pa, pb) = (self.point(a), self.point(b));
         let (pa, pb) = (pa?, pb?);
         if pa.body == pb.body {
@@ -201,7 +210,7 @@ impl Checker {
         }
         if self.ground[pa.body] && self.ground[pb.body] {
             self.errors.push(
-                span,
+                b.body.span(),
                 format!(
                     "this joint connects two ground bodies (`{}` and `{}`), which cannot move; \
                      connect at least one moving body",
@@ -213,10 +222,10 @@ impl Checker {
         Some((pa, pb))
     }
 
-    fn joint(&mut self, name: &Ident, span: Span, kind: &JointKind) -> Option<ConstraintKind> {
+    fn joint(&mut self, name: &Ident, kind: &JointKind) -> Option<ConstraintKind> {
         match kind {
             JointKind::Revolute { a, b } => {
-                let (a, b) = self.two_points(a, b, span)?;
+                let (a, b) = self.two_points(a, b)?;
                 Some(ConstraintKind::Revolute { a, b })
             }
             JointKind::Prismatic {
@@ -225,7 +234,7 @@ impl Checker {
                 axis,
                 axis_span,
             } => {
-                let points = self.two_points(a, b, span);
+                let points = self.two_points(a, b);
                 let ux = self.geometry(&axis[0]);
                 let uy = self.geometry(&axis[1]);
                 let (ux2, uy2) = (self.arena.powi(ux, 2), self.arena.powi(uy, 2));
@@ -244,7 +253,7 @@ impl Checker {
                 Some(ConstraintKind::Prismatic { a, b, axis })
             }
             JointKind::Distance { a, b, length } => {
-                let points = self.two_points(a, b, span);
+                let points = self.two_points(a, b);
                 let value = self.geometry(length);
                 if self.arena.as_const(value) == Some(0.0) {
                     self.errors.push(
@@ -342,7 +351,10 @@ impl Checker {
         let dof = 3 * moving as i64 - joint_equations as i64;
         let drivers = spec.drivers.len() as i64;
         let count = format!(
-            "Gruebler count: 3 × {moving} moving bodies − {joint_equations} joint equations = {dof}"
+            "Gruebler count: 3 × {moving} moving bod{} − {joint_equations} joint equation{} = {}",
+            if moving == 1 { "y" } else { "ies" },
+            plural(joint_equations as i64),
+            if dof < 0 { format!("−{}", -dof) } else { dof.to_string() },
         );
         if dof < 0 {
             self.errors.push(
@@ -354,11 +366,16 @@ impl Checker {
             );
         } else if drivers < dof {
             let missing = dof - drivers;
+            let example = spec
+                .bodies
+                .iter()
+                .find(|b| !b.ground)
+                .map_or_else(|| "BODY".to_owned(), |b| b.name.to_string());
             self.errors.push(
                 spec.name.span(),
                 format!(
                     "`{}` has {dof} degree{} of freedom but {drivers} driver{} ({count}); add \
-                     {missing} driver{}, e.g. `driver NAME: angle(BODY) = omega * t;`",
+                     {missing} driver{}, e.g. `driver spin: angle({example}) = t;`",
                     spec.name,
                     plural(dof),
                     plural(drivers),
@@ -372,9 +389,10 @@ impl Checker {
                     driver.name.span(),
                     format!(
                         "too many drivers: `{}` has {dof} degree{} of freedom but {drivers} \
-                         drivers ({count}); remove {extra} driver{}",
+                         driver{} ({count}); remove {extra} driver{}",
                         spec.name,
                         plural(dof),
+                        plural(drivers),
                         plural(extra),
                     ),
                 );
@@ -437,7 +455,13 @@ impl Checker {
                     None => {
                         let mut names: Vec<(&String, &u32)> = self.params.iter().collect();
                         names.sort_by_key(|(_, i)| **i);
-                        let hint = if names.is_empty() {
+                        let close = did_you_mean(
+                            &key,
+                            names.iter().map(|(n, _)| n.as_str()).chain(["t"]),
+                        );
+                        let hint = if let Some(close) = close {
+                            format!("did you mean `{close}`?")
+                        } else if names.is_empty() {
                             "declare it with `param NAME = VALUE;`".to_owned()
                         } else {
                             let list: Vec<String> =
@@ -480,7 +504,8 @@ impl Checker {
                 match Func::from_name(&f.to_string()) {
                     Some(func) => self.arena.call(func, arg),
                     None => {
-                        let names: Vec<&str> = Func::ALL.iter().map(|f| f.name()).collect();
+                        let names: Vec<String> =
+                            Func::ALL.iter().map(|f| format!("`{}`", f.name())).collect();
                         self.errors.push(
                             f.span(),
                             format!(
@@ -498,6 +523,32 @@ impl Checker {
 
 fn plural(n: i64) -> &'static str {
     if n == 1 { "" } else { "s" }
+}
+
+/// The candidate closest to a misspelt `name`, if it is plausibly a typo (edit distance ≤ 2 and
+/// less than half the name).
+fn did_you_mean<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    candidates
+        .map(|c| (edit_distance(name, c), c))
+        .filter(|&(d, _)| d <= 2 && 2 * d < name.chars().count().max(2))
+        .min()
+        .map(|(_, c)| c)
+}
+
+/// Levenshtein distance (names are short; the quadratic table is fine).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let substitution = diagonal + usize::from(ca != cb);
+            diagonal = row[j + 1];
+            row[j + 1] = substitution.min(row[j] + 1).min(row[j + 1] + 1);
+        }
+    }
+    row[b.len()]
 }
 
 #[cfg(test)]
@@ -584,6 +635,15 @@ mod tests {
         assert!(msgs.contains("time `t` can only appear"), "{msgs}");
         assert!(msgs.contains("zero vector"), "{msgs}");
         assert!(msgs.contains("distance of zero"), "{msgs}");
+    }
+
+    #[test]
+    fn typos_get_a_suggestion() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(did_you_mean("omgea", ["omega", "t"].into_iter()), Some("omega"));
+        assert_eq!(did_you_mean("x", ["t"].into_iter()), None);
+        let msgs = errors(&scene("driver d: angle(crnk) = w * t;")).join("\n");
+        assert!(msgs.contains("did you mean `crank`?"), "{msgs}");
     }
 
     #[test]

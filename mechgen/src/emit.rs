@@ -44,7 +44,12 @@ pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
     });
     let param_writes = model.params.iter().map(|p| {
         let (name, key) = (&p.name, p.name.to_string());
-        quote! { #key => self.#name = value, }
+        quote! {
+            #key => {
+                self.#name = value;
+                ::core::result::Result::Ok(())
+            }
+        }
     });
 
     let coordinate_consts = coordinate_names.iter().enumerate().map(|(i, c)| {
@@ -109,7 +114,7 @@ pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
     let (phi_doc, phi_body, phi_args) = (phi.doc("Φ(q, t)"), phi.body, phi.args);
     let (jac_doc, jac_body, jac_args) = (jacobian.doc("Φ_q(q, t)"), jacobian.body, jacobian.args);
     let (pj_doc, pj_body, pj_args) = (
-        phi_and_jacobian.doc("Φ and Φ_q together, sharing sub-expressions"),
+        phi_and_jacobian.doc("Φ and Φ_q in one pass, sharing sub-expressions"),
         phi_and_jacobian.body,
         phi_and_jacobian.args,
     );
@@ -124,7 +129,11 @@ pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
     let bodies_trait = format_ident!("{}Bodies", name);
     let bodies_doc = format!(
         " Named access to the bodies of a solved [`{name}`] state: `state.{}().x`.",
-        model.bodies.first().map_or("body".to_owned(), |b| b.name.to_string())
+        model
+            .bodies
+            .iter()
+            .find(|b| !b.ground)
+            .map_or("body".to_owned(), |b| b.name.to_string())
     );
     let accessor_decls = model.bodies.iter().map(|b| {
         let ident = &b.name;
@@ -225,17 +234,15 @@ pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
                 }
                 match name {
                     #(#param_writes)*
-                    _ => return ::core::result::Result::Err(::mechgen_runtime::ParameterError::Unknown),
+                    _ => ::core::result::Result::Err(::mechgen_runtime::ParameterError::Unknown),
                 }
-                #[allow(unreachable_code)]
-                ::core::result::Result::Ok(())
             }
 
             fn initial_guess(&self, q: &mut ::mechgen_runtime::Vector<Self::Dim>) {
                 #guess_body
             }
 
-            #[doc = #phi_doc]
+            #phi_doc
             fn phi(
                 &self,
                 #phi_q: &::mechgen_runtime::Vector<Self::Dim>,
@@ -245,7 +252,7 @@ pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
                 #phi_body
             }
 
-            #[doc = #jac_doc]
+            #jac_doc
             fn jacobian(
                 &self,
                 #jac_q: &::mechgen_runtime::Vector<Self::Dim>,
@@ -255,7 +262,7 @@ pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
                 #jac_body
             }
 
-            #[doc = #pj_doc]
+            #pj_doc
             fn phi_and_jacobian(
                 &self,
                 #pj_q: &::mechgen_runtime::Vector<Self::Dim>,
@@ -266,7 +273,7 @@ pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
                 #pj_body
             }
 
-            #[doc = #nu_doc]
+            #nu_doc
             fn nu(
                 &self,
                 #nu_q: &::mechgen_runtime::Vector<Self::Dim>,
@@ -276,7 +283,7 @@ pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
                 #nu_body
             }
 
-            #[doc = #gamma_doc]
+            #gamma_doc
             fn gamma(
                 &self,
                 #gamma_q: &::mechgen_runtime::Vector<Self::Dim>,
@@ -339,8 +346,10 @@ struct Function {
 }
 
 impl Function {
-    fn doc(&self, what: &str) -> String {
-        format!(" Writes {what}. Operations: {}.", self.counts)
+    /// Two doc lines: what the function writes, and what it costs.
+    fn doc(&self, what: &str) -> TokenStream {
+        let (what, cost) = (format!(" Writes {what}."), format!(" Operations: {}.", self.counts));
+        quote! { #[doc = #what] #[doc = ""] #[doc = #cost] }
     }
 }
 

@@ -133,7 +133,7 @@ fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> {
                 syn::Error::new(e.span(), "expected `near (x, y, angle)`: an initial guess")
             })?;
         }
-        let pose = tuple::<3>(input)?;
+        let (pose, _) = tuple::<3>(input, "(x, y, angle)")?;
         spec.bodies.push(BodyDecl {
             docs,
             keyword,
@@ -184,11 +184,10 @@ fn joint_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, JointKind)>
         "revolute" => JointKind::Revolute { a, b },
         "prismatic" => {
             args.parse::<Token![,]>()?;
-            let axis_span = args.span();
             args.parse::<kw::along>().map_err(|e| {
                 syn::Error::new(e.span(), "expected `along (ux, uy)`: the axis in the first body's frame")
             })?;
-            let axis = tuple::<2>(&args)?;
+            let (axis, axis_span) = tuple::<2>(&args, "(ux, uy)")?;
             JointKind::Prismatic {
                 a,
                 b,
@@ -253,7 +252,7 @@ impl Parse for PointRef {
         let body = input.parse()?;
         let local = if input.peek(Token![@]) {
             input.parse::<Token![@]>()?;
-            Some(tuple::<2>(input)?)
+            Some(tuple::<2>(input, "(x, y)")?.0)
         } else {
             None
         };
@@ -261,8 +260,11 @@ impl Parse for PointRef {
     }
 }
 
-/// `(e1, …, eN)` with exactly N expressions.
-fn tuple<const N: usize>(input: ParseStream) -> syn::Result<[Expr; N]> {
+/// `(e1, …, eN)` with exactly N expressions (`what` names them for the error), and its span.
+fn tuple<const N: usize>(
+    input: ParseStream,
+    what: &str,
+) -> syn::Result<([Expr; N], proc_macro2::Span)> {
     let content;
     let paren = parenthesized!(content in input);
     let mut items = Vec::with_capacity(N);
@@ -274,12 +276,14 @@ fn tuple<const N: usize>(input: ParseStream) -> syn::Result<[Expr; N]> {
         content.parse::<Token![,]>()?;
     }
     let found = items.len();
-    items.try_into().map_err(|_| {
+    let span = paren.span.join();
+    let items = items.try_into().map_err(|_| {
         syn::Error::new(
-            paren.span.join(),
-            format!("expected {N} comma-separated values, found {found}"),
+            span,
+            format!("expected {N} comma-separated values {what}, found {found}"),
         )
-    })
+    })?;
+    Ok((items, span))
 }
 
 impl Parse for Expr {

@@ -38,6 +38,6 @@ pub use state::{BodyState, State, write_csv_header};
 /// Re-exported so generated code and users name one crate.
 pub use nalgebra;
 
-/// Declares a mechanism and generates its kinematics; see the `mechgen` crate for the grammar.
+/// Declares a mechanism and generates its kinematics; the grammar is documented in `mechgen::parse`.
 #[cfg(feature = "macros")]
 pub use mechgen_macros::mechanism;

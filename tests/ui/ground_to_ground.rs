@@ -1,0 +1,21 @@
+//! A joint between two ground bodies (`frame` and `bearing`, where the crank was meant to sit in
+//! the bearing), which can never move; the error points at the joint kind.
+use mechgen_runtime::mechanism;
+
+mechanism! {
+    mechanism SliderCrank {
+        param omega = 10.0;
+        ground frame at (0, 0, 0);
+        ground bearing at (0, 0, 0);
+        body crank near (0, 0, 0);
+        body rod near (1, 0, 0);
+        body slider near (3, 0, 0);
+        joint pivot: revolute(frame, bearing);
+        joint crank_pin: revolute(crank @ (1, 0), rod);
+        joint wrist_pin: revolute(rod @ (2, 0), slider);
+        joint slide: prismatic(frame, slider, along (1, 0));
+        driver spin: angle(crank) = omega * t;
+    }
+}
+
+fn main() {}

@@ -1,0 +1,14 @@
+//! Joints that remove more freedom than the bodies have (a pendulum pinned twice); the error
+//! points at the mechanism's name.
+use mechgen_runtime::mechanism;
+
+mechanism! {
+    mechanism Pendulum {
+        ground frame at (0, 0, 0);
+        body bob near (1, 0, 0);
+        joint pivot: revolute(frame, bob @ (-1, 0));
+        joint stop: revolute(frame @ (1, 0), bob);
+    }
+}
+
+fn main() {}

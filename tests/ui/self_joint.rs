@@ -1,0 +1,19 @@
+//! A joint joining a body to itself (`rod` to `rod`); the error points at the second `rod`.
+use mechgen_runtime::mechanism;
+
+mechanism! {
+    mechanism SliderCrank {
+        param omega = 10.0;
+        ground frame at (0, 0, 0);
+        body crank near (0, 0, 0);
+        body rod near (1, 0, 0);
+        body slider near (3, 0, 0);
+        joint pivot: revolute(frame, crank);
+        joint crank_pin: revolute(crank @ (1, 0), rod);
+        joint wrist_pin: revolute(rod @ (2, 0), rod);
+        joint slide: prismatic(frame, slider, along (1, 0));
+        driver spin: angle(crank) = omega * t;
+    }
+}
+
+fn main() {}
