@@ -43,7 +43,12 @@ impl Interpreted {
         let (model, kin) = (&scene.model, &scene.kinematics);
         let arena = &model.arena;
         let jacobian_values: Vec<_> = kin.jacobian.iter().map(|e| e.value).collect();
-        let both: Vec<_> = kin.phi.iter().copied().chain(jacobian_values.iter().copied()).collect();
+        let both: Vec<_> = kin
+            .phi
+            .iter()
+            .copied()
+            .chain(jacobian_values.iter().copied())
+            .collect();
         let tapes = [
             Tape::new(arena, &kin.guess),
             Tape::new(arena, &kin.phi),
@@ -189,15 +194,21 @@ impl Mechanism for Interpreted {
         jacobian: &mut Matrix<Dyn>,
     ) {
         let n = self.coordinates.len();
-        self.run(&self.phi_and_jacobian, self.inputs(q.as_slice(), &[], t), |v| {
-            let (phi_values, jacobian_values) = v.split_at(n.min(v.len()));
-            copy_into(phi_values, phi);
-            self.write_jacobian(jacobian_values, jacobian);
-        });
+        self.run(
+            &self.phi_and_jacobian,
+            self.inputs(q.as_slice(), &[], t),
+            |v| {
+                let (phi_values, jacobian_values) = v.split_at(n.min(v.len()));
+                copy_into(phi_values, phi);
+                self.write_jacobian(jacobian_values, jacobian);
+            },
+        );
     }
 
     fn nu(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
-        self.run(&self.nu, self.inputs(q.as_slice(), &[], t), |v| copy_into(v, out));
+        self.run(&self.nu, self.inputs(q.as_slice(), &[], t), |v| {
+            copy_into(v, out)
+        });
     }
 
     fn gamma(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {

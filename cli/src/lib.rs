@@ -1,1 +1,212 @@
-//! mechgen CLI library (placeholder).
+//! Tools over the interpreter: the `mechgen` command line (`expand`, `check`, `solve`) and the
+//! [`Interpreted`] adapter that runs `.mech` scenes through the runtime's solver.
+//!
+//! The binary is a thin wrapper around [`run`]; the pieces are public so that tests and reports
+//! can reuse them (notably [`solve::sample_time`], the CLI's exact sample times).
+
+pub mod args;
+pub mod diagnostics;
+pub mod inspect;
+mod interpreted;
+pub mod solve;
+
+use std::ffi::OsString;
+use std::io::{self, Read, Write};
+use std::path::Path;
+
+pub use args::{Command, USAGE};
+pub use interpreted::Interpreted;
+
+use args::{Input, Output, SolveArgs};
+
+/// Exit status for a bad command line.
+pub const EXIT_USAGE: u8 = 2;
+/// Exit status for a scene with errors, an unreadable file or a failed solve.
+pub const EXIT_FAILURE: u8 = 1;
+
+/// How a command failed.
+#[derive(Debug)]
+enum Failure {
+    /// A bad command line: the message is followed by the usage.
+    Usage(String),
+    /// Anything else: the complete text for stderr.
+    Failed(String),
+    /// Standard output was closed by the reader (`mechgen solve … | head`): stop quietly.
+    BrokenPipe,
+}
+
+fn failed(message: impl core::fmt::Display) -> Failure {
+    Failure::Failed(format!("error: {message}"))
+}
+
+/// Runs the command line `args` (without the program name), writing results to `stdout` and
+/// messages to `stderr`, and returns the exit status: 0, [`EXIT_FAILURE`] or [`EXIT_USAGE`].
+pub fn run(
+    args: impl IntoIterator<Item = OsString>,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> u8 {
+    let outcome = match args::parse(args) {
+        Ok(command) => execute(command, stdout, stderr),
+        Err(error) => Err(Failure::Usage(error.0)),
+    };
+    let outcome = outcome.and_then(|()| stdout.flush().map_err(|e| write_failure(&e, "stdout")));
+    // Nothing sensible is left to do if stderr itself cannot be written.
+    match outcome {
+        Ok(()) | Err(Failure::BrokenPipe) => 0,
+        Err(Failure::Usage(message)) => {
+            let _ = write!(stderr, "error: {message}\n\n{USAGE}");
+            EXIT_USAGE
+        }
+        Err(Failure::Failed(message)) => {
+            let _ = writeln!(stderr, "{message}");
+            EXIT_FAILURE
+        }
+    }
+}
+
+fn execute(
+    command: Command,
+    stdout: &mut dyn Write,
+    stderr: &mut dyn Write,
+) -> Result<(), Failure> {
+    match command {
+        Command::Help => print(stdout, USAGE),
+        Command::Version => print(stdout, &format!("mechgen {}\n", env!("CARGO_PKG_VERSION"))),
+        Command::Expand { input } => {
+            let source = read_source(&input)?;
+            let code = mechgen::expand_pretty(&source.text)
+                .map_err(|errors| compile_failure(&source, &errors))?;
+            print(stdout, &code)
+        }
+        Command::Check { input, stats } => {
+            let source = read_source(&input)?;
+            let scene = compile(&source)?;
+            print(stdout, &inspect::report(&scene, &source.name, stats))
+        }
+        Command::Solve(args) => solve(&args, stdout, stderr),
+    }
+}
+
+fn print(stdout: &mut dyn Write, text: &str) -> Result<(), Failure> {
+    stdout
+        .write_all(text.as_bytes())
+        .map_err(|e| write_failure(&e, "stdout"))
+}
+
+fn write_failure(error: &io::Error, destination: &str) -> Failure {
+    if error.kind() == io::ErrorKind::BrokenPipe && destination == "stdout" {
+        Failure::BrokenPipe
+    } else {
+        failed(format_args!("cannot write to {destination}: {error}"))
+    }
+}
+
+/// A scene's text and the name its errors are reported under.
+struct Source {
+    name: String,
+    text: String,
+}
+
+fn read_source(input: &Input) -> Result<Source, Failure> {
+    match input {
+        Input::Stdin => {
+            let mut text = String::new();
+            io::stdin()
+                .read_to_string(&mut text)
+                .map_err(|e| read_failure("standard input", &e))?;
+            Ok(Source {
+                name: "<stdin>".to_owned(),
+                text,
+            })
+        }
+        Input::File(path) => {
+            let name = path.display().to_string();
+            let text = std::fs::read_to_string(path).map_err(|e| read_failure(&name, &e))?;
+            Ok(Source { name, text })
+        }
+    }
+}
+
+fn read_failure(name: &str, error: &io::Error) -> Failure {
+    let hint = match error.kind() {
+        io::ErrorKind::NotFound => "check the path (it is relative to the current directory)",
+        io::ErrorKind::InvalidData => "the file must be UTF-8 text: re-save it as UTF-8",
+        io::ErrorKind::PermissionDenied => "check the file's permissions",
+        io::ErrorKind::IsADirectory => "give a .mech file, not a directory",
+        _ => "give a readable .mech file",
+    };
+    failed(format_args!(
+        "cannot read `{name}`: {error}\n  hint: {hint}"
+    ))
+}
+
+fn compile(source: &Source) -> Result<mechgen::Scene, Failure> {
+    mechgen::compile_str(&source.text).map_err(|errors| compile_failure(source, &errors))
+}
+
+fn compile_failure(source: &Source, errors: &mechgen::Errors) -> Failure {
+    Failure::Failed(diagnostics::render(&source.name, &source.text, errors))
+}
+
+fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
+    let source = read_source(&args.input)?;
+    let scene = compile(&source)?;
+    let mut mechanism = Interpreted::new(&scene);
+    solve::apply_sets(&mut mechanism, &args.sets).map_err(failed)?;
+    // Assemble before touching the output, so that a scene that cannot move leaves an existing
+    // CSV file as it was.
+    let mut simulation = solve::assemble(mechanism, args.t0).map_err(failed)?;
+
+    let mut file;
+    let (out, destination): (&mut dyn Write, String) = match &args.csv {
+        Output::Stdout => (stdout, "stdout".to_owned()),
+        Output::File(path) => {
+            refuse_to_overwrite_input(&args.input, path)?;
+            let name = path.display().to_string();
+            file = io::BufWriter::new(std::fs::File::create(path).map_err(|e| {
+                failed(format_args!(
+                    "cannot create `{name}`: {e}\n  hint: check that its directory exists \
+                     and is writable"
+                ))
+            })?);
+            (&mut file, format!("`{name}`"))
+        }
+    };
+
+    let range = format!("t = {} to {}", args.t0, args.t_end);
+    match solve::run(&mut simulation, args.t_end, args.steps, out) {
+        Ok(summary) => {
+            let _ = writeln!(
+                stderr,
+                "mechgen: wrote {} rows to {destination} ({range}, {} step{}); {} Newton \
+                 iterations in total; max residual ‖Φ‖∞ = {:e}",
+                summary.rows,
+                args.steps,
+                if args.steps == 1 { "" } else { "s" },
+                summary.iterations,
+                summary.max_residual
+            );
+            Ok(())
+        }
+        Err(solve::RunError::Write(e)) => Err(write_failure(&e, &destination)),
+        Err(solve::RunError::Solve { message, summary }) => Err(failed(format_args!(
+            "{message}\n  note: wrote {} rows to {destination} ({} Newton iterations) before \
+             the failure",
+            summary.rows, summary.iterations
+        ))),
+    }
+}
+
+fn refuse_to_overwrite_input(input: &Input, csv: &Path) -> Result<(), Failure> {
+    let Input::File(scene) = input else {
+        return Ok(());
+    };
+    match (scene.canonicalize(), csv.canonicalize()) {
+        (Ok(a), Ok(b)) if a == b => Err(failed(format_args!(
+            "`--csv {}` would overwrite the scene itself: give another file name",
+            csv.display()
+        ))),
+        _ => Ok(()),
+    }
+}

@@ -354,7 +354,11 @@ impl Checker {
             "Gruebler count: 3 × {moving} moving bod{} − {joint_equations} joint equation{} = {}",
             if moving == 1 { "y" } else { "ies" },
             plural(joint_equations as i64),
-            if dof < 0 { format!("−{}", -dof) } else { dof.to_string() },
+            if dof < 0 {
+                format!("−{}", -dof)
+            } else {
+                dof.to_string()
+            },
         );
         if dof < 0 {
             self.errors.push(
@@ -455,10 +459,8 @@ impl Checker {
                     None => {
                         let mut names: Vec<(&String, &u32)> = self.params.iter().collect();
                         names.sort_by_key(|(_, i)| **i);
-                        let close = did_you_mean(
-                            &key,
-                            names.iter().map(|(n, _)| n.as_str()).chain(["t"]),
-                        );
+                        let close =
+                            did_you_mean(&key, names.iter().map(|(n, _)| n.as_str()).chain(["t"]));
                         let hint = if let Some(close) = close {
                             format!("did you mean `{close}`?")
                         } else if names.is_empty() {
@@ -504,8 +506,10 @@ impl Checker {
                 match Func::from_name(&f.to_string()) {
                     Some(func) => self.arena.call(func, arg),
                     None => {
-                        let names: Vec<String> =
-                            Func::ALL.iter().map(|f| format!("`{}`", f.name())).collect();
+                        let names: Vec<String> = Func::ALL
+                            .iter()
+                            .map(|f| format!("`{}`", f.name()))
+                            .collect();
                         self.errors.push(
                             f.span(),
                             format!(
@@ -582,7 +586,9 @@ mod tests {
 
     #[test]
     fn a_valid_scene_checks() {
-        let spec = parse_str(&scene("driver d: angle(crank) = w * t;")).ok().expect("parses");
+        let spec = parse_str(&scene("driver d: angle(crank) = w * t;"))
+            .ok()
+            .expect("parses");
         let model = check(&spec).ok().expect("checks");
         assert_eq!(model.dim(), 12);
         assert_eq!(model.equation_names().len(), 12);
@@ -608,7 +614,10 @@ mod tests {
     #[test]
     fn degrees_of_freedom_must_match_drivers() {
         let missing = errors(&scene("")).join("\n");
-        assert!(missing.contains("1 degree of freedom but 0 drivers"), "{missing}");
+        assert!(
+            missing.contains("1 degree of freedom but 0 drivers"),
+            "{missing}"
+        );
         let extra = errors(&scene(
             "driver d: angle(crank) = t; driver e: x(slider) = t;",
         ))
@@ -640,7 +649,10 @@ mod tests {
     #[test]
     fn typos_get_a_suggestion() {
         assert_eq!(edit_distance("kitten", "sitting"), 3);
-        assert_eq!(did_you_mean("omgea", ["omega", "t"].into_iter()), Some("omega"));
+        assert_eq!(
+            did_you_mean("omgea", ["omega", "t"].into_iter()),
+            Some("omega")
+        );
         assert_eq!(did_you_mean("x", ["t"].into_iter()), None);
         let msgs = errors(&scene("driver d: angle(crnk) = w * t;")).join("\n");
         assert!(msgs.contains("did you mean `crank`?"), "{msgs}");

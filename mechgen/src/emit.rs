@@ -160,7 +160,10 @@ pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
         }
     });
 
-    let coordinate_doc = format!(" Coordinate names in q order ({n} = 3 × {} bodies).", model.bodies.len());
+    let coordinate_doc = format!(
+        " Coordinate names in q order ({n} = 3 × {} bodies).",
+        model.bodies.len()
+    );
     let equation_doc = format!(" Equation names in Φ order ({n} equations).");
     let pattern_doc = format!(
         " Structural non-zeros of Φ_q as (equation, coordinate), row-major: {jacobian_count} of {}.",
@@ -348,7 +351,10 @@ struct Function {
 impl Function {
     /// Two doc lines: what the function writes, and what it costs.
     fn doc(&self, what: &str) -> TokenStream {
-        let (what, cost) = (format!(" Writes {what}."), format!(" Operations: {}.", self.counts));
+        let (what, cost) = (
+            format!(" Writes {what}."),
+            format!(" Operations: {}.", self.counts),
+        );
         quote! { #[doc = #what] #[doc = ""] #[doc = #cost] }
     }
 }
@@ -365,8 +371,10 @@ impl Context<'_> {
     /// A function body writing `outputs` (non-zero entries; zeros are cleared in one call).
     fn function(&self, outputs: &[(TokenStream, Id)], clear: TokenStream) -> Function {
         let arena = self.arena();
-        let nonzero: Vec<&(TokenStream, Id)> =
-            outputs.iter().filter(|(_, id)| !arena.is_zero(*id)).collect();
+        let nonzero: Vec<&(TokenStream, Id)> = outputs
+            .iter()
+            .filter(|(_, id)| !arena.is_zero(*id))
+            .collect();
         let roots: Vec<Id> = nonzero.iter().map(|(_, id)| *id).collect();
         let order = topological_order(arena, &roots);
 
@@ -395,7 +403,9 @@ impl Context<'_> {
             let operand = |x: Id| -> (TokenStream, Prec) {
                 match &bound[x.index()] {
                     Some(ident) => (quote!(#ident), Prec::Atom),
-                    None => rendered[x.index()].clone().unwrap_or_else(|| (quote!(0.0), Prec::Atom)),
+                    None => rendered[x.index()]
+                        .clone()
+                        .unwrap_or_else(|| (quote!(0.0), Prec::Atom)),
                 }
             };
             let (tokens, prec) = match node {
@@ -444,8 +454,8 @@ impl Context<'_> {
                 }
             };
             let is_leaf = matches!(node, Node::Const(_) | Node::Param(_) | Node::Var(Var::T));
-            let bind = !is_leaf
-                && (matches!(node, Node::Var(_) | Node::Call(..)) || uses[id.index()] > 1);
+            let bind =
+                !is_leaf && (matches!(node, Node::Var(_) | Node::Call(..)) || uses[id.index()] > 1);
             if bind {
                 let ident = names.fresh(&self.suggest(id));
                 let statement = quote! { let #ident = #tokens; };
@@ -595,7 +605,9 @@ pub fn f64_literal(value: f64) -> TokenStream {
     let magnitude = value.abs();
     // `{:?}` is the shortest representation that round-trips, with an exponent for extremes.
     let text = format!("{magnitude:?}");
-    let literal: Literal = text.parse().unwrap_or_else(|_| Literal::f64_unsuffixed(magnitude));
+    let literal: Literal = text
+        .parse()
+        .unwrap_or_else(|_| Literal::f64_unsuffixed(magnitude));
     if value.is_sign_negative() {
         quote!(-#literal)
     } else {
@@ -609,7 +621,17 @@ mod tests {
 
     #[test]
     fn literals_round_trip() {
-        for v in [0.0, 1.0, 156.8, 1e-6, 1e-300, 6.02e23, 0.1 + 0.2, f64::MAX, -2.5] {
+        for v in [
+            0.0,
+            1.0,
+            156.8,
+            1e-6,
+            1e-300,
+            6.02e23,
+            0.1 + 0.2,
+            f64::MAX,
+            -2.5,
+        ] {
             let text = f64_literal(v).to_string().replace(['(', ')', ' '], "");
             assert_eq!(text.parse::<f64>().unwrap(), v, "{text}");
         }

@@ -36,6 +36,29 @@ pub struct Kinematics {
     pub guess: Vec<Id>,
 }
 
+impl Kinematics {
+    /// The non-zero outputs of each generated kinematic function, by function name: what the
+    /// emitter computes (zeros are cleared, not computed) and what operation counts cover.
+    pub fn function_outputs(&self, arena: &Arena) -> [(&'static str, Vec<Id>); 5] {
+        let nonzero = |ids: &[Id]| -> Vec<Id> {
+            ids.iter()
+                .copied()
+                .filter(|&id| !arena.is_zero(id))
+                .collect()
+        };
+        let phi = nonzero(&self.phi);
+        let jacobian: Vec<Id> = self.jacobian.iter().map(|e| e.value).collect();
+        let both = phi.iter().chain(&jacobian).copied().collect();
+        [
+            ("phi", phi),
+            ("jacobian", jacobian),
+            ("phi_and_jacobian", both),
+            ("nu", nonzero(&self.nu)),
+            ("gamma", nonzero(&self.gamma)),
+        ]
+    }
+}
+
 /// Derives Φ, Φ_q, ν and γ, adding their nodes to the model's arena.
 pub fn derive(model: &mut Model) -> Kinematics {
     let phi = constraint_equations(model);
@@ -124,7 +147,11 @@ fn constraint_equations(model: &mut Model) -> Vec<Id> {
                 let (tb, ta) = (coord(a, pb.body, 2), coord(a, pa.body, 2));
                 phi.push(a.sub(tb, ta));
             }
-            ConstraintKind::Distance { a: pa, b: pb, length } => {
+            ConstraintKind::Distance {
+                a: pa,
+                b: pb,
+                length,
+            } => {
                 let d = separation(a, pa, pb);
                 let squared = dot(a, d, d);
                 let l2 = a.powi(length, 2);

@@ -19,6 +19,7 @@ pub mod error;
 pub mod expr;
 pub mod interpret;
 pub mod kinematics;
+pub mod limits;
 pub mod model;
 pub mod parse;
 pub mod spec;

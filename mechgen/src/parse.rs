@@ -43,8 +43,9 @@ mod kw {
 /// Parses a `mechanism` declaration from tokens (the macro's input).
 ///
 /// # Errors
-/// The first syntax error, at its tokens.
+/// Input beyond the size limits (`limits`), or the first syntax error, at its tokens.
 pub fn parse_tokens(tokens: TokenStream) -> syn::Result<Spec> {
+    crate::limits::check(&tokens)?;
     syn::parse2(tokens)
 }
 
@@ -53,7 +54,8 @@ pub fn parse_tokens(tokens: TokenStream) -> syn::Result<Spec> {
 /// # Errors
 /// The first lexical or syntax error, with its position in the text.
 pub fn parse_str(source: &str) -> syn::Result<Spec> {
-    syn::parse_str(source)
+    let tokens: TokenStream = syn::parse_str(source)?;
+    parse_tokens(tokens)
 }
 
 impl Parse for Spec {
@@ -126,7 +128,10 @@ fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> {
         let name = input.parse()?;
         if ground {
             input.parse::<kw::at>().map_err(|e| {
-                syn::Error::new(e.span(), "expected `at (x, y, angle)`: the ground body's pose")
+                syn::Error::new(
+                    e.span(),
+                    "expected `at (x, y, angle)`: the ground body's pose",
+                )
             })?;
         } else {
             input.parse::<kw::near>().map_err(|e| {
@@ -185,7 +190,10 @@ fn joint_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, JointKind)>
         "prismatic" => {
             args.parse::<Token![,]>()?;
             args.parse::<kw::along>().map_err(|e| {
-                syn::Error::new(e.span(), "expected `along (ux, uy)`: the axis in the first body's frame")
+                syn::Error::new(
+                    e.span(),
+                    "expected `along (ux, uy)`: the axis in the first body's frame",
+                )
             })?;
             let (axis, axis_span) = tuple::<2>(&args, "(ux, uy)")?;
             JointKind::Prismatic {
@@ -343,7 +351,10 @@ fn power(input: ParseStream) -> syn::Result<Expr> {
     input.parse::<Token![^]>()?;
     let negative = input.parse::<Option<Token![-]>>()?.is_some();
     let exponent: LitInt = input.parse().map_err(|e| {
-        syn::Error::new(e.span(), "`^` takes an integer exponent, such as `t^2` or `x^-1`")
+        syn::Error::new(
+            e.span(),
+            "`^` takes an integer exponent, such as `t^2` or `x^-1`",
+        )
     })?;
     let magnitude: i32 = exponent.base10_parse()?;
     let n = if negative { -magnitude } else { magnitude };
@@ -481,7 +492,9 @@ mod tests {
     #[test]
     fn syntax_errors_say_what_was_expected() {
         let err = |s: &str| parse_str(s).err().expect("an error").to_string();
-        assert!(err("mechanism M { joint j: hinge(a, b); }").contains("unknown joint kind `hinge`"));
+        assert!(
+            err("mechanism M { joint j: hinge(a, b); }").contains("unknown joint kind `hinge`")
+        );
         assert!(err("mechanism M { body b at (0, 0, 0); }").contains("near (x, y, angle)"));
         assert!(err("mechanism M { body b near (0, 0); }").contains("expected 3"));
         assert!(err("mechanism M { param p = 1f32; }").contains("suffix"));

@@ -3,7 +3,9 @@
 
 use std::fmt;
 
+use crate::Scene;
 use crate::expr::{Arena, Func, Id, Node};
+use crate::interpret::topological_order;
 
 /// How many operations of each kind a straight-line evaluation performs (each DAG node once).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -62,4 +64,47 @@ impl fmt::Display for OpCounts {
             self.trig, self.sqrt, self.exp_ln, self.mul, self.add, self.div, self.neg
         )
     }
+}
+
+/// Operation counts of one generated function.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FunctionCounts {
+    /// The generated function's name (`phi`, `jacobian`, `phi_and_jacobian`, `nu`, `gamma`).
+    pub function: &'static str,
+    /// Non-zero outputs it writes (zeros come from one `fill(0.0)`).
+    pub outputs: usize,
+    /// Operations, each shared sub-expression once.
+    pub counts: OpCounts,
+}
+
+/// Operation counts of every generated kinematic function, counted exactly as the emitter does
+/// for its doc comments: over the DAG reachable from the non-zero outputs, each node once.
+pub fn function_counts(scene: &Scene) -> Vec<FunctionCounts> {
+    let arena = &scene.model.arena;
+    scene
+        .kinematics
+        .function_outputs(arena)
+        .into_iter()
+        .map(|(function, roots)| FunctionCounts {
+            function,
+            outputs: roots.len(),
+            counts: OpCounts::of(arena, &topological_order(arena, &roots)),
+        })
+        .collect()
+}
+
+/// [`function_counts`] as a text table (CLI `check --stats`, snapshots).
+pub fn table(scene: &Scene) -> String {
+    let mut out = format!(
+        "{:<17}{:>8}{:>6}{:>6}{:>8}{:>6}{:>6}{:>6}{:>6}\n",
+        "function", "outputs", "trig", "sqrt", "exp/ln", "mul", "add", "div", "neg"
+    );
+    for f in function_counts(scene) {
+        let c = f.counts;
+        out += &format!(
+            "{:<17}{:>8}{:>6}{:>6}{:>8}{:>6}{:>6}{:>6}{:>6}\n",
+            f.function, f.outputs, c.trig, c.sqrt, c.exp_ln, c.mul, c.add, c.div, c.neg
+        );
+    }
+    out
 }

@@ -31,7 +31,7 @@ mod state;
 pub use error::{Described, Quantity, SolveError};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use mechanism::{Matrix, Mechanism, ParameterError, Storage, Vector};
-pub use simulate::Simulation;
+pub use simulate::{Simulation, sample_time};
 pub use solver::{Convergence, Solver, SolverOptions};
 pub use state::{BodyState, State, write_csv_header};
 

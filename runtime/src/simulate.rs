@@ -104,12 +104,21 @@ where
         visit(&self.current);
         let t_start = self.current.t;
         for k in 1..=steps {
-            // Interpolated from the ends, not accumulated, so the last time is exactly `t_end`.
-            let s = k as f64 / steps as f64;
-            let state = self.step_to(t_start * (1.0 - s) + t_end * s)?;
+            let state = self.step_to(sample_time(t_start, t_end, steps, k))?;
             visit(state);
         }
         Ok(())
+    }
+}
+
+/// The k-th of `steps` equal steps from `t0` to `t_end`: `t0 + k·(t_end − t0)/steps`, computed
+/// from the ends rather than accumulated (no drift), and exactly `t_end` at `k = steps`. Every
+/// caller sampling a motion (the CLI, examples, tests) uses this so their times agree to the bit.
+pub fn sample_time(t0: f64, t_end: f64, steps: usize, k: usize) -> f64 {
+    if k >= steps {
+        t_end
+    } else {
+        t0 + k as f64 * (t_end - t0) / steps as f64
     }
 }
 
@@ -117,6 +126,20 @@ where
 mod tests {
     use super::*;
     use crate::pendulum::Pendulum;
+
+    #[test]
+    fn sample_times_hit_both_ends_and_are_not_accumulated() {
+        assert_eq!(sample_time(0.0, 0.02, 10, 0), 0.0);
+        assert_eq!(sample_time(0.0, 0.02, 10, 10), 0.02);
+        assert_eq!(
+            sample_time(0.0, 2.0 * core::f64::consts::PI / 314.0, 360, 360),
+            2.0 * core::f64::consts::PI / 314.0
+        );
+        assert_eq!(sample_time(1.0, -1.0, 4, 2), 0.0);
+        assert_eq!(sample_time(0.0, 1.0, 10, 3), 0.3);
+        let accumulated = (0..3).fold(0.0, |t, _| t + 1.0 / 10.0);
+        assert_ne!(accumulated, 0.3);
+    }
 
     fn iterations(predictor: bool) -> usize {
         let mut simulation = Simulation::new(Solver::new(Pendulum::default()), 0.0).unwrap();

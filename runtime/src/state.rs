@@ -95,9 +95,11 @@ where
     /// # Errors
     /// Whatever `out` returns.
     pub fn write_csv_row<W: Write>(&self, out: &mut W) -> fmt::Result {
-        write!(out, "{}", self.t)?;
+        // `{:?}` is the shortest round-trip form, with an exponent for tiny and huge values
+        // (`5.2e-30`, not thirty zeros).
+        write!(out, "{:?}", self.t)?;
         for value in self.q.iter().chain(&self.qd).chain(&self.qdd) {
-            write!(out, ",{value}")?;
+            write!(out, ",{value:?}")?;
         }
         out.write_char('\n')
     }

@@ -9,10 +9,6 @@
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use mechgen::expr::Id;
-use mechgen::interpret::topological_order;
-use mechgen::stats::OpCounts;
-
 /// The example scenes, sorted by file name so that snapshot order (and failure order) is stable;
 /// a new `.mech` file gets its snapshots without touching this test.
 fn scenes() -> Vec<PathBuf> {
@@ -69,53 +65,15 @@ fn operation_counts() {
     }
 }
 
-/// One row per generated function: outputs written (non-zero entries only, as emitted) and the
-/// operations of evaluating their DAG once, shared sub-expressions counted once.
+/// The Jacobian's sparsity and the operation table of every generated function.
 fn operation_table(source: &str) -> Result<String, mechgen::Errors> {
-    let mechgen::Scene { model, kinematics } = mechgen::compile_str(source)?;
-    let arena = &model.arena;
-    // The emitter computes only non-zero outputs (zeros come from one `fill(0.0)`), so count
-    // only those; the Jacobian holds its structural non-zeros already.
-    let nonzero = |ids: &[Id]| -> Vec<Id> {
-        ids.iter()
-            .copied()
-            .filter(|&id| !arena.is_zero(id))
-            .collect()
-    };
-    let phi = nonzero(&kinematics.phi);
-    let jacobian: Vec<Id> = kinematics.jacobian.iter().map(|e| e.value).collect();
-    let phi_and_jacobian: Vec<Id> = phi.iter().chain(&jacobian).copied().collect();
-    let functions = [
-        ("phi", phi),
-        ("jacobian", jacobian),
-        ("phi_and_jacobian", phi_and_jacobian),
-        ("nu", nonzero(&kinematics.nu)),
-        ("gamma", nonzero(&kinematics.gamma)),
-    ];
-
-    let n = model.dim();
+    let scene = mechgen::compile_str(source)?;
+    let n = scene.model.dim();
     let mut table = format!(
         "{n} coordinates; Jacobian: {} structural non-zeros of {}\n\n",
-        kinematics.jacobian.len(),
+        scene.kinematics.jacobian.len(),
         n * n
     );
-    table += &format!(
-        "{:<16} {:>7} {:>4} {:>4} {:>6} {:>4} {:>4} {:>4} {:>4}\n",
-        "function", "outputs", "trig", "sqrt", "exp/ln", "mul", "add", "div", "neg"
-    );
-    for (name, roots) in &functions {
-        let c = OpCounts::of(arena, &topological_order(arena, roots));
-        table += &format!(
-            "{name:<16} {:>7} {:>4} {:>4} {:>6} {:>4} {:>4} {:>4} {:>4}\n",
-            roots.len(),
-            c.trig,
-            c.sqrt,
-            c.exp_ln,
-            c.mul,
-            c.add,
-            c.div,
-            c.neg
-        );
-    }
+    table += &mechgen::stats::table(&scene);
     Ok(table)
 }

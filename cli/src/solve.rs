@@ -1,0 +1,207 @@
+//! `mechgen solve`: steps a scene through time with the interpreter behind the runtime's own
+//! [`Solver`] and [`Simulation`] (the code generated scenes use), writing one CSV row per time.
+
+use std::io::Write;
+
+use mechgen_runtime::nalgebra::DVector;
+use mechgen_runtime::{
+    Mechanism, Simulation, SolveError, Solver, State, sample_time, write_csv_header,
+};
+
+use crate::Interpreted;
+
+/// Totals over a run, for the summary line.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Summary {
+    /// CSV data rows written (one per solved time).
+    pub rows: usize,
+    /// Newton updates over all position solves, assembly included.
+    pub iterations: usize,
+    /// Largest ‖Φ‖∞ at any solved positions.
+    pub max_residual: f64,
+}
+
+/// Why a run stopped early.
+#[derive(Debug)]
+pub enum RunError {
+    /// Writing a row failed.
+    Write(std::io::Error),
+    /// A solve failed; the message already names the time, equations and coordinates.
+    Solve {
+        /// The named description of the solver error, with a hint.
+        message: String,
+        /// What was done before the failure.
+        summary: Summary,
+    },
+}
+
+/// Sets the `--set` overrides on `mechanism`, all or none.
+///
+/// # Errors
+/// A message naming the bad override and listing the parameters the scene declares.
+pub fn apply_sets(mechanism: &mut Interpreted, sets: &[(String, f64)]) -> Result<(), String> {
+    // Checked before any is set, so that the list in the message shows the scene's defaults.
+    for (name, value) in sets {
+        let declared = (0..mechanism.parameter_count())
+            .any(|i| mechanism.parameter_name(i) == Some(name.as_str()));
+        let problem = if !declared {
+            format!("the scene declares no parameter `{name}`")
+        } else if !value.is_finite() {
+            "parameter values must be finite numbers".to_owned()
+        } else {
+            continue;
+        };
+        return Err(format!(
+            "`--set {name}={value}`: {problem}; {}",
+            declared_parameters(mechanism)
+        ));
+    }
+    for (name, value) in sets {
+        mechanism
+            .set_parameter(name, *value)
+            .map_err(|error| format!("`--set {name}={value}`: {error}"))?;
+    }
+    Ok(())
+}
+
+fn declared_parameters(mechanism: &Interpreted) -> String {
+    let list: Vec<String> = (0..mechanism.parameter_count())
+        .filter_map(|i| {
+            let name = mechanism.parameter_name(i)?;
+            let value = mechanism.parameter(i)?;
+            Some(format!("`{name}` (default {value})"))
+        })
+        .collect();
+    if list.is_empty() {
+        "the scene declares no parameters, so `--set` cannot be used with it".to_owned()
+    } else {
+        format!("declared parameters: {}", list.join(", "))
+    }
+}
+
+/// Assembles `mechanism` at `t0`.
+///
+/// # Errors
+/// The solver's error, described with the scene's names and a hint.
+pub fn assemble(mechanism: Interpreted, t0: f64) -> Result<Simulation<Interpreted>, String> {
+    // `Simulation::new` drops the solver (and the mechanism's names) on failure.
+    let names = mechanism.clone();
+    Simulation::new(Solver::new(mechanism), t0).map_err(|error| {
+        format!(
+            "cannot assemble `{}`: {}\n  hint: {}",
+            names.name(),
+            error.describe(&names),
+            assembly_hint(&error)
+        )
+    })
+}
+
+fn assembly_hint(error: &SolveError) -> &'static str {
+    match error {
+        SolveError::NoConvergence { .. } => {
+            "move the `near (x, y, angle)` guesses of the moving bodies closer to an assembled \
+             pose, or check the dimensions: the joints may not be able to close at all"
+        }
+        SolveError::Singular { .. } => {
+            "the named equation is redundant or conflicts with others at this pose: check the \
+             joints, or move the `near` guesses away from a dead-centre position"
+        }
+        _ => "check the parameter values and the `near` guesses for divisions by zero",
+    }
+}
+
+fn step_hint(error: &SolveError) -> &'static str {
+    match error {
+        SolveError::NoConvergence { .. } => {
+            "the mechanism may stop being able to assemble here (a joint cannot close), or the \
+             time step is too large: try more `--steps`"
+        }
+        SolveError::Singular { .. } => {
+            "the mechanism reaches a singular position (dead centre or a locked joint): check \
+             the dimensions, or end the run before this time"
+        }
+        _ => "a value became NaN or infinite: check the parameter values and the time range",
+    }
+}
+
+/// Writes the CSV header and the rows of an assembled simulation over `steps` equal steps
+/// from its current time `t0` to `t_end`, flushing `out` even when a solve fails.
+///
+/// # Errors
+/// [`RunError::Write`] when `out` fails, [`RunError::Solve`] when a step does.
+pub fn run(
+    simulation: &mut Simulation<Interpreted>,
+    t_end: f64,
+    steps: usize,
+    out: &mut dyn Write,
+) -> Result<Summary, RunError> {
+    let t0 = simulation.state().t;
+    let mut line = String::new();
+    // Writing to a String cannot fail.
+    let _ = write_csv_header(simulation.solver().mechanism(), &mut line);
+    out.write_all(line.as_bytes()).map_err(RunError::Write)?;
+
+    let dim = simulation.solver().mechanism().len();
+    let mut phi = DVector::zeros(dim);
+    let mut summary = Summary::default();
+    let mut record = |simulation: &Simulation<Interpreted>,
+                      out: &mut dyn Write,
+                      summary: &mut Summary|
+     -> Result<(), RunError> {
+        let state: &State<Interpreted> = simulation.state();
+        line.clear();
+        let _ = state.write_csv_row(&mut line);
+        out.write_all(line.as_bytes()).map_err(RunError::Write)?;
+        // The state does not keep the solver's residual; Φ at the returned q is that residual.
+        simulation
+            .solver()
+            .mechanism()
+            .phi(&state.q, state.t, &mut phi);
+        summary.rows += 1;
+        summary.iterations += state.iterations;
+        summary.max_residual = summary.max_residual.max(phi.amax());
+        Ok(())
+    };
+
+    record(simulation, out, &mut summary)?;
+    for k in 1..=steps {
+        let t = sample_time(t0, t_end, steps, k);
+        if let Err(error) = simulation.step_to(t) {
+            out.flush().map_err(RunError::Write)?;
+            let message = format!(
+                "solve failed at step {k} of {steps}: {}\n  hint: {}",
+                error.describe(simulation.solver().mechanism()),
+                step_hint(&error)
+            );
+            return Err(RunError::Solve { message, summary });
+        }
+        record(simulation, out, &mut summary)?;
+    }
+    out.flush().map_err(RunError::Write)?;
+    Ok(summary)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overrides_name_the_declared_parameters() {
+        let scene = mechgen::compile_str(
+            "mechanism M { param w = 3; ground g at (0, 0, 0); body b near (0, 0, 0);
+             joint j: revolute(g, b); driver d: angle(b) = w * t; }",
+        )
+        .expect("compiles");
+        let mut mechanism = Interpreted::new(&scene);
+        assert!(apply_sets(&mut mechanism, &[("w".into(), 5.0)]).is_ok());
+        assert_eq!(mechanism.parameter(0), Some(5.0));
+        let mut fresh = Interpreted::new(&scene);
+        let sets = [("w".into(), 7.0), ("v".into(), 1.0)];
+        let unknown = apply_sets(&mut fresh, &sets).unwrap_err();
+        assert!(unknown.contains("no parameter `v`"), "{unknown}");
+        assert!(unknown.contains("`w` (default 3)"), "{unknown}");
+        assert_eq!(fresh.parameter(0), Some(3.0), "all or none");
+        let infinite = apply_sets(&mut mechanism, &[("w".into(), f64::INFINITY)]).unwrap_err();
+        assert!(infinite.contains("finite"), "{infinite}");
+    }
+}

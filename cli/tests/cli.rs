@@ -1,0 +1,307 @@
+//! End-to-end tests of the `mechgen` binary: each command on the example scenes, error reports
+//! with positions, and bad command lines.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use mechgen_runtime::sample_time;
+
+/// Positions of the seed at t = 0 from its closed form: piston x of the boxer piston-crank.
+const SEED_PISTON_X_AT_0: f64 = 129.89921491356055;
+
+fn scene(name: &str) -> String {
+    format!("{}/../examples/scenes/{name}", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn mechgen(args: &[&str]) -> Output {
+    match Command::new(env!("CARGO_BIN_EXE_mechgen"))
+        .args(args)
+        .output()
+    {
+        Ok(output) => output,
+        Err(e) => panic!("cannot run mechgen: {e}"),
+    }
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// A fresh path under Cargo's per-test scratch directory.
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("mechgen-cli-tests");
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    dir.join(name)
+}
+
+#[test]
+fn expand_prints_the_generated_mechanism() {
+    let out = mechgen(&["expand", &scene("piston_crank.mech")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let code = text(&out.stdout);
+    assert!(
+        code.contains("impl ::mechgen_runtime::Mechanism for PistonCrank"),
+        "{code}"
+    );
+}
+
+#[test]
+fn check_lists_coordinates_equations_and_freedom() {
+    let out = mechgen(&["check", &scene("piston_crank.mech")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let report = text(&out.stdout);
+    for expected in [
+        "mechanism PistonCrank",
+        "coordinates (15):",
+        "   3  piston.x\n",
+        "equations (15):",
+        "  14  crank_angle\n",
+        "degrees of freedom: 1 ",
+        "matched by 1 driver",
+        "of 225 (15 × 15)",
+        "omega = 314",
+    ] {
+        assert!(
+            report.contains(expected),
+            "missing {expected:?} in\n{report}"
+        );
+    }
+    assert!(!report.contains("operation counts"), "{report}");
+}
+
+#[test]
+fn check_stats_prints_operation_counts_like_the_generated_docs() {
+    let path = scene("piston_crank.mech");
+    let out = mechgen(&["check", &path, "--stats"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let report = text(&out.stdout);
+    assert!(report.contains("operation counts"), "{report}");
+    let rows: Vec<Vec<&str>> = report
+        .lines()
+        .skip_while(|l| !l.contains("operation counts"))
+        .skip(2)
+        .map(|l| l.split_whitespace().collect())
+        .collect();
+    let functions: Vec<&str> = rows.iter().map(|r| r[0]).collect();
+    assert_eq!(
+        functions,
+        ["phi", "jacobian", "phi_and_jacobian", "nu", "gamma"],
+        "{report}"
+    );
+
+    // The same numbers the emitter writes into the generated doc comments.
+    let expanded = text(&mechgen(&["expand", &path]).stdout);
+    // The counts line follows the function's first doc line (the two may share a line).
+    let doc = |what: &str| -> String {
+        let mut lines = expanded
+            .lines()
+            .skip_while(|l| !l.contains(&format!("/// Writes {what}")));
+        lines
+            .by_ref()
+            .take(4)
+            .find_map(|l| l.split("Operations: ").nth(1))
+            .unwrap_or_else(|| panic!("no operation counts documented for {what}"))
+            .to_owned()
+    };
+    for (row, what) in rows
+        .iter()
+        .zip(["Φ(q, t)", "Φ_q(q, t)", "Φ and Φ_q", "ν", "γ"])
+    {
+        let [trig, sqrt, exp_ln, mul, add, div, neg] = [2, 3, 4, 5, 6, 7, 8].map(|i| row[i]);
+        let expected = format!(
+            "{trig} trig, {sqrt} sqrt, {exp_ln} exp/ln, {mul} mul, {add} add, {div} div, {neg} neg."
+        );
+        assert_eq!(doc(what), expected, "{what}");
+    }
+}
+
+#[test]
+fn solve_writes_one_row_per_sample_time() {
+    let csv = scratch("seed.csv");
+    let (t_end, steps) = (0.01, 8);
+    let out = mechgen(&[
+        "solve",
+        &scene("piston_crank.mech"),
+        "--t-end",
+        "0.01",
+        "--steps",
+        "8",
+        "--csv",
+        csv.to_str().expect("UTF-8 path"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(out.stdout.is_empty(), "the CSV went to the file");
+    let summary = text(&out.stderr);
+    assert!(summary.contains("wrote 9 rows"), "{summary}");
+    assert!(summary.contains("Newton iterations"), "{summary}");
+
+    let written = std::fs::read_to_string(&csv).expect("CSV written");
+    let lines: Vec<&str> = written.lines().collect();
+    assert_eq!(lines.len(), 1 + (steps + 1));
+    let header: Vec<&str> = lines[0].split(',').collect();
+    assert_eq!(header.len(), 1 + 3 * 15);
+    assert_eq!(header[..2], ["t", "liner.x"]);
+    assert!(header.contains(&"piston.x_dot") && header.contains(&"piston.x_ddot"));
+    let piston_x = header
+        .iter()
+        .position(|&h| h == "piston.x")
+        .expect("piston.x column");
+
+    for (k, line) in lines[1..].iter().enumerate() {
+        let row: Vec<f64> = line
+            .split(',')
+            .map(|v| v.parse().expect("a number"))
+            .collect();
+        assert_eq!(row.len(), header.len());
+        assert_eq!(row[0], sample_time(0.0, t_end, steps, k), "row {k}");
+        assert!(row.iter().all(|v| v.is_finite()), "row {k}");
+    }
+    let first: f64 = lines[1]
+        .split(',')
+        .nth(piston_x)
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0.0);
+    assert!((first - SEED_PISTON_X_AT_0).abs() < 1e-9, "{first}");
+    let _ = std::fs::remove_file(&csv);
+}
+
+#[test]
+fn solve_to_stdout_with_a_parameter_and_start_time() {
+    let out = mechgen(&[
+        "solve",
+        &scene("four_bar.mech"),
+        "--t0=0.5",
+        "--t-end=1",
+        "--steps=2",
+        "--set",
+        "omega=-3",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let csv = text(&out.stdout);
+    let times: Vec<&str> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap_or(""))
+        .collect();
+    assert_eq!(times, ["0.5", "0.75", "1.0"]);
+    // omega = -3: the crank angle is -3 t.
+    let header: Vec<&str> = csv.lines().next().unwrap_or("").split(',').collect();
+    let theta = header
+        .iter()
+        .position(|&h| h == "crank.theta")
+        .expect("crank.theta");
+    let last: f64 = csv
+        .lines()
+        .last()
+        .and_then(|l| l.split(',').nth(theta)?.parse().ok())
+        .unwrap_or(0.0);
+    assert!((last + 3.0).abs() < 1e-9, "{last}");
+}
+
+#[test]
+fn unknown_parameters_list_the_declared_ones() {
+    let out = mechgen(&[
+        "solve",
+        &scene("piston_crank.mech"),
+        "--t-end",
+        "1",
+        "--steps",
+        "1",
+        "--set",
+        "speed=3",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let message = text(&out.stderr);
+    assert!(message.contains("no parameter `speed`"), "{message}");
+    assert!(message.contains("`omega` (default 314)"), "{message}");
+    assert!(out.stdout.is_empty());
+}
+
+#[test]
+fn scene_errors_are_all_reported_with_line_and_column() {
+    let path = scratch("broken.mech");
+    let source = "\
+/// Broken on purpose.
+mechanism Broken {
+    ground frame at (0, 0, 0);
+    body arm near (1, 0, 0);
+    body arm near (2, 0, 0);
+    joint pivot: revolute(frame, ghost @ (1, 0));
+    driver spin: angle(arm) = t;
+}
+";
+    std::fs::write(&path, source).expect("scene written");
+    let name = path.to_str().expect("UTF-8 path");
+    for command in ["check", "expand", "solve"] {
+        let mut args = vec![command, name];
+        if command == "solve" {
+            args.extend(["--t-end", "1", "--steps", "1"]);
+        }
+        let out = mechgen(&args);
+        assert_eq!(out.status.code(), Some(1), "{command}");
+        let errors = text(&out.stderr);
+        let duplicate = format!("{name}:5:10: error: duplicate name `arm`");
+        let unknown = format!("{name}:6:34: error: unknown body `ghost`");
+        assert!(errors.contains(&duplicate), "{command}: {errors}");
+        assert!(errors.contains(&unknown), "{command}: {errors}");
+        assert!(
+            errors.contains("6 |     joint pivot: revolute(frame, ghost @ (1, 0));\n  |"),
+            "{errors}"
+        );
+        assert!(
+            errors.contains("\n  |                                  ^^^^^\n"),
+            "{errors}"
+        );
+        assert!(out.stdout.is_empty(), "{command}");
+    }
+    let _ = std::fs::remove_file(&path);
+}
+
+#[test]
+fn unreadable_files_say_so() {
+    let out = mechgen(&["check", "no/such/scene.mech"]);
+    assert_eq!(out.status.code(), Some(1));
+    let message = text(&out.stderr);
+    assert!(
+        message.contains("cannot read `no/such/scene.mech`"),
+        "{message}"
+    );
+    assert!(message.contains("hint: check the path"), "{message}");
+}
+
+#[test]
+fn bad_command_lines_exit_2_with_usage() {
+    let seed = scene("piston_crank.mech");
+    for args in [
+        &[][..],
+        &["frobnicate"],
+        &["check"],
+        &["check", &seed, "--verbose"],
+        &["expand", &seed, "--stats"],
+        &["solve", &seed, "--steps", "10"],
+        &["solve", &seed, "--t-end", "soon", "--steps", "10"],
+        &["solve", &seed, "--t-end", "1", "--steps", "0"],
+        &[
+            "solve", &seed, "--t-end", "1", "--steps", "2", "--set", "omega",
+        ],
+    ] {
+        let out = mechgen(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let message = text(&out.stderr);
+        assert!(message.starts_with("error: "), "{args:?}: {message}");
+        assert!(
+            message.contains("Usage:\n  mechgen expand FILE"),
+            "{args:?}: {message}"
+        );
+        assert!(out.stdout.is_empty(), "{args:?}");
+    }
+}
+
+#[test]
+fn help_goes_to_stdout_and_succeeds() {
+    for args in [&["help"][..], &["--help"], &["-h"], &["solve", "--help"]] {
+        let out = mechgen(args);
+        assert!(out.status.success(), "{args:?}");
+        assert!(text(&out.stdout).contains("Usage:"), "{args:?}");
+    }
+}
