@@ -61,10 +61,20 @@ where
 fn kinematics(c: &mut Criterion) {
     let seed_period = 2.0 * std::f64::consts::PI / PistonCrank::default().omega;
     bench_scene(c, "seed/generated", PistonCrank::default(), seed_period);
-    bench_scene(c, "seed/interpreted", interpreted("piston_crank.mech"), seed_period);
+    bench_scene(
+        c,
+        "seed/interpreted",
+        interpreted("piston_crank.mech"),
+        seed_period,
+    );
     let four_bar_period = 2.0 * std::f64::consts::PI / FourBar::default().omega;
     bench_scene(c, "four_bar/generated", FourBar::default(), four_bar_period);
-    bench_scene(c, "four_bar/interpreted", interpreted("four_bar.mech"), four_bar_period);
+    bench_scene(
+        c,
+        "four_bar/interpreted",
+        interpreted("four_bar.mech"),
+        four_bar_period,
+    );
 }
 
 criterion_group! {

@@ -19,9 +19,18 @@ fn main() {
     let run = demo::revolution(scene, exact.period(), 360, |t| exact.kinematics(t))
         .unwrap_or_else(|e| demo::exit_with(&e, &scene));
 
-    println!("Crank-rocker four-bar, ω = {} rad/s, one revolution in 360 steps\n", scene.omega);
-    println!("{:>6} {:>12} {:>14} {:>16}", "crank", "rocker θ", "rocker θ̇", "rocker θ̈");
-    println!("{:>6} {:>12} {:>14} {:>16}", "(deg)", "(deg)", "(rad/s)", "(rad/s²)");
+    println!(
+        "Crank-rocker four-bar, ω = {} rad/s, one revolution in 360 steps\n",
+        scene.omega
+    );
+    println!(
+        "{:>6} {:>12} {:>14} {:>16}",
+        "crank", "rocker θ", "rocker θ̇", "rocker θ̈"
+    );
+    println!(
+        "{:>6} {:>12} {:>14} {:>16}",
+        "(deg)", "(deg)", "(rad/s)", "(rad/s²)"
+    );
     for state in run.states.iter().step_by(30) {
         let rocker = state.rocker();
         println!(
@@ -36,7 +45,10 @@ fn main() {
     print!("{}", run.summary());
 
     let series = |f: fn(&State<FourBar>) -> f64| -> Vec<(f64, f64)> {
-        run.states.iter().map(|s| (s.crank().theta.to_degrees(), f(s))).collect()
+        run.states
+            .iter()
+            .map(|s| (s.crank().theta.to_degrees(), f(s)))
+            .collect()
     };
     let (th, w, a) = (
         series(|s| s.rocker().theta.to_degrees()),
@@ -44,9 +56,27 @@ fn main() {
         series(|s| s.rocker().theta_ddot),
     );
     let panels = [
-        Panel { y_label: "rocker θ (deg)", series: &[Series { name: "", points: &th }] },
-        Panel { y_label: "rocker θ̇ (rad/s)", series: &[Series { name: "", points: &w }] },
-        Panel { y_label: "rocker θ̈ (rad/s²)", series: &[Series { name: "", points: &a }] },
+        Panel {
+            y_label: "rocker θ (deg)",
+            series: &[Series {
+                name: "",
+                points: &th,
+            }],
+        },
+        Panel {
+            y_label: "rocker θ̇ (rad/s)",
+            series: &[Series {
+                name: "",
+                points: &w,
+            }],
+        },
+        Panel {
+            y_label: "rocker θ̈ (rad/s²)",
+            series: &[Series {
+                name: "",
+                points: &a,
+            }],
+        },
     ];
     let title = "Crank-rocker four-bar: rocker motion over one crank revolution";
     match plot::write_svg(&options.svg, title, "crank angle (deg)", &panels) {

@@ -9,18 +9,28 @@ use mechgen_examples::plot::{self, Panel, Series};
 use mechgen_examples::scenes::{PistonCrank, PistonCrankBodies};
 
 fn main() {
-    let options = Options::from_args("piston_crank", std::env::args().skip(1)).unwrap_or_else(|e| {
-        eprintln!("error: {e}");
-        std::process::exit(2)
-    });
+    let options =
+        Options::from_args("piston_crank", std::env::args().skip(1)).unwrap_or_else(|e| {
+            eprintln!("error: {e}");
+            std::process::exit(2)
+        });
     let scene = PistonCrank::default();
     let exact = closed_form::PistonCrank::default();
     let run = demo::revolution(scene, exact.period(), 360, |t| exact.kinematics(t))
         .unwrap_or_else(|e| demo::exit_with(&e, &scene));
 
-    println!("Seed piston-crank, ω = {} rad/s, one revolution in 360 steps\n", scene.omega);
-    println!("{:>6} {:>14} {:>14} {:>16}", "crank", "piston x", "piston ẋ", "piston ẍ");
-    println!("{:>6} {:>14} {:>14} {:>16}", "(deg)", "(mm)", "(mm/s)", "(mm/s²)");
+    println!(
+        "Seed piston-crank, ω = {} rad/s, one revolution in 360 steps\n",
+        scene.omega
+    );
+    println!(
+        "{:>6} {:>14} {:>14} {:>16}",
+        "crank", "piston x", "piston ẋ", "piston ẍ"
+    );
+    println!(
+        "{:>6} {:>14} {:>14} {:>16}",
+        "(deg)", "(mm)", "(mm/s)", "(mm/s²)"
+    );
     for state in run.states.iter().step_by(30) {
         let piston = state.piston();
         let crank = state.crank().theta.to_degrees();
@@ -42,9 +52,27 @@ fn main() {
         series(|s| s.piston().x_ddot),
     );
     let panels = [
-        Panel { y_label: "piston x (mm)", series: &[Series { name: "", points: &x }] },
-        Panel { y_label: "piston ẋ (mm/s)", series: &[Series { name: "", points: &v }] },
-        Panel { y_label: "piston ẍ (mm/s²)", series: &[Series { name: "", points: &a }] },
+        Panel {
+            y_label: "piston x (mm)",
+            series: &[Series {
+                name: "",
+                points: &x,
+            }],
+        },
+        Panel {
+            y_label: "piston ẋ (mm/s)",
+            series: &[Series {
+                name: "",
+                points: &v,
+            }],
+        },
+        Panel {
+            y_label: "piston ẍ (mm/s²)",
+            series: &[Series {
+                name: "",
+                points: &a,
+            }],
+        },
     ];
     let title = "Seed piston-crank: piston motion over one crank revolution";
     match plot::write_svg(&options.svg, title, "crank angle (deg)", &panels) {

@@ -336,7 +336,7 @@ mod tests {
     const SEED_CSV: &str = include_str!("../../tests/data/seed_reference.csv");
 
     /// Parses the reference table: rows of `t, q[15], qd[15], qdd[15]`.
-    fn seed_rows() -> Vec<(f64, [f64; 15], [f64; 15], [f64; 15])> {
+    fn seed_rows() -> Vec<Kinematics<15>> {
         let mut lines = SEED_CSV.lines();
         let header = lines.next().expect("header");
         assert_eq!(header.split(',').count(), 46);
@@ -349,7 +349,12 @@ mod tests {
                     .collect();
                 assert_eq!(v.len(), 46, "row width");
                 let block = |k: usize| -> [f64; 15] { core::array::from_fn(|i| v[1 + 15 * k + i]) };
-                (v[0], block(0), block(1), block(2))
+                Kinematics {
+                    t: v[0],
+                    q: block(0),
+                    qd: block(1),
+                    qdd: block(2),
+                }
             })
             .collect()
     }
@@ -362,8 +367,8 @@ mod tests {
         assert_eq!(rows.len(), 1000);
         let pc = PistonCrank::default();
         let mut col_max = [[0.0f64; 15]; 3];
-        for (_, q, qd, qdd) in &rows {
-            for (k, blk) in [q, qd, qdd].into_iter().enumerate() {
+        for row in &rows {
+            for (k, blk) in [&row.q, &row.qd, &row.qdd].into_iter().enumerate() {
                 for i in 0..15 {
                     col_max[k][i] = col_max[k][i].max(blk[i].abs());
                 }
@@ -372,9 +377,10 @@ mod tests {
         let blk_max = col_max.map(|c| c.iter().copied().fold(0.0, f64::max));
         let mut per_col = [0.0f64; 3];
         let mut per_blk = [0.0f64; 3];
-        for (t, q, qd, qdd) in &rows {
-            let kin = pc.kinematics(*t);
-            for (k, (got, want)) in [(&kin.q, q), (&kin.qd, qd), (&kin.qdd, qdd)]
+        for row in &rows {
+            let t = row.t;
+            let kin = pc.kinematics(t);
+            for (k, (got, want)) in [(&kin.q, &row.q), (&kin.qd, &row.qd), (&kin.qdd, &row.qdd)]
                 .into_iter()
                 .enumerate()
             {
@@ -397,8 +403,8 @@ mod tests {
         let (per_col, per_blk) = seed_errors();
         eprintln!("seed vs reference, per-column relative max error (q, qd, qdd): {per_col:?}");
         eprintln!("seed vs reference, per-block relative max error (q, qd, qdd): {per_blk:?}");
-        for k in 0..3 {
-            assert!(per_col[k] <= 1e-13, "block {k}: {}", per_col[k]);
+        for (k, err) in per_col.iter().enumerate() {
+            assert!(*err <= 1e-13, "block {k}: {err}");
         }
     }
 
@@ -420,7 +426,9 @@ mod tests {
     #[test]
     fn seed_constraints_hold() {
         let pc = PistonCrank::default();
-        let rot = |th: f64, (x, y): (f64, f64)| (th.cos() * x - th.sin() * y, th.sin() * x + th.cos() * y);
+        let rot = |th: f64, (x, y): (f64, f64)| {
+            (th.cos() * x - th.sin() * y, th.sin() * x + th.cos() * y)
+        };
         for i in 0..200 {
             let t = pc.period() * i as f64 / 200.0;
             let q = pc.q(t);
@@ -434,7 +442,10 @@ mod tests {
                 (pt(3, (0.0, 0.0)), pt(4, (0.0, 0.0))),
             ];
             for (a, b) in pairs {
-                assert!((a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12, "t={t}");
+                assert!(
+                    (a.0 - b.0).abs() < 1e-12 && (a.1 - b.1).abs() < 1e-12,
+                    "t={t}"
+                );
             }
             assert!(q[4].abs() < 1e-12 && q[5] == 0.0);
         }
@@ -456,6 +467,34 @@ mod tests {
                         let f = if i % 3 == 2 { 1.0 } else { scale };
                         let err = (got[i] / f - want[i]).abs() / m;
                         assert!(err < 1e-13, "scale {scale} t {t} coord {i}: {err}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// Raising ω only rescales time: q(t·ω₁/ω₂) is unchanged, q̇ scales by ω₂/ω₁ and q̈ by (ω₂/ω₁)².
+    #[test]
+    fn fast_seed_is_the_seed_in_rescaled_time() {
+        let base = PistonCrank::default();
+        for omega in [1e5, 1.0] {
+            let fast = PistonCrank { omega, ..base };
+            let r = omega / base.omega;
+            for i in 0..100 {
+                let t = base.period() * (i as f64 + 0.5) / 100.0;
+                let (a, b) = (base.kinematics(t), fast.kinematics(t / r));
+                for (k, (want, got, f)) in [
+                    (&a.q, &b.q, 1.0),
+                    (&a.qd, &b.qd, r),
+                    (&a.qdd, &b.qdd, r * r),
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    let m = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                    for i in 0..15 {
+                        let err = (got[i] / f - want[i]).abs() / m;
+                        assert!(err < 1e-13, "ω {omega} t {t} block {k} coord {i}: {err}");
                     }
                 }
             }
@@ -491,7 +530,9 @@ mod tests {
     fn four_bar_constraints_hold_and_branch_is_left() {
         let fb = FourBar::default();
         let (a, b, c, d) = (fb.crank, fb.coupler, fb.rocker, fb.ground);
-        let rot = |th: f64, (x, y): (f64, f64)| (th.cos() * x - th.sin() * y, th.sin() * x + th.cos() * y);
+        let rot = |th: f64, (x, y): (f64, f64)| {
+            (th.cos() * x - th.sin() * y, th.sin() * x + th.cos() * y)
+        };
         let n = 2000;
         let mut prev: Option<[f64; 12]> = None;
         for i in 0..=n {
@@ -508,7 +549,10 @@ mod tests {
                 (pt(3, (0.0, 0.0)), pt(0, (d, 0.0))),
             ];
             for (p1, p2) in pairs {
-                assert!((p1.0 - p2.0).abs() < 1e-12 && (p1.1 - p2.1).abs() < 1e-12, "t={t}");
+                assert!(
+                    (p1.0 - p2.0).abs() < 1e-12 && (p1.1 - p2.1).abs() < 1e-12,
+                    "t={t}"
+                );
             }
             // Driver.
             assert!((q[5] - fb.omega * t).abs() < 1e-15 * (1.0 + q[5].abs()));
@@ -517,7 +561,11 @@ mod tests {
             let cross = (d - pa.0) * (pb.1 - pa.1) - (0.0 - pa.1) * (pb.0 - pa.0);
             assert!(cross > 0.0, "t={t}: B on wrong branch");
             // Documented angle ranges (no atan2 wrap): θ3 ∈ (0, π), θ4 ∈ [54.9°, 128.7°].
-            assert!(q[8] > 0.0 && q[8] < core::f64::consts::PI, "t={t}: θ3 = {}", q[8]);
+            assert!(
+                q[8] > 0.0 && q[8] < core::f64::consts::PI,
+                "t={t}: θ3 = {}",
+                q[8]
+            );
             let th4 = q[11].to_degrees();
             assert!((54.8..=128.8).contains(&th4), "t={t}: θ4 = {th4}°");
             // Continuity: no jump between neighbouring samples.
@@ -555,7 +603,10 @@ mod tests {
                 (vel(3, (0.0, 0.0)), vel(0, (d, 0.0))),
             ];
             for (v1, v2) in pairs {
-                assert!((v1.0 - v2.0).abs() < 1e-10 && (v1.1 - v2.1).abs() < 1e-10, "t={t}");
+                assert!(
+                    (v1.0 - v2.0).abs() < 1e-10 && (v1.1 - v2.1).abs() < 1e-10,
+                    "t={t}"
+                );
             }
             assert_eq!(k.qd[5], fb.omega);
         }

@@ -3,7 +3,7 @@
 //! plotting used by the example binaries.
 
 pub mod accuracy;
-pub mod demo;
-pub mod scenes;
 pub mod closed_form;
+pub mod demo;
 pub mod plot;
+pub mod scenes;

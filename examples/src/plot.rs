@@ -75,15 +75,24 @@ fn draw_err<E: fmt::Debug>(e: E) -> PlotError {
 /// Figure width, px.
 const WIDTH: u32 = 900;
 /// Height reserved for the title, px.
-const TITLE_H: u32 = 50;
+const TITLE_H: u32 = 46;
 /// Height of each panel's plotting band (plot area plus a small gap), px.
-const PANEL_H: u32 = 262;
+const PANEL_H: u32 = 258;
 /// Extra height under the bottom panel for the x tick labels and the x axis label, px.
-const X_AXIS_H: u32 = 54;
+const X_AXIS_H: u32 = 56;
 /// Outer margin, px.
 const MARGIN: u32 = 12;
 /// Width of the y label area; fixed so the plot areas of all panels line up, px.
 const Y_AXIS_W: u32 = 96;
+/// Internal supersampling factor. plotters rounds every coordinate to an integer pixel, which makes
+/// curves visibly jagged at 900 px; drawing at twice the size and declaring the nominal size on the
+/// `<svg>` element (the `viewBox` keeps the doubled coordinates) halves that quantisation.
+const RES: u32 = 2;
+
+/// A nominal length (px or font size) in internal drawing units.
+const fn px(v: u32) -> i32 {
+    (v * RES) as i32
+}
 
 /// Colour-blind-friendly categorical palette (Tableau 10 order), so multi-series panels stay readable.
 const PALETTE: [RGBColor; 6] = [
@@ -105,7 +114,12 @@ pub fn figure_size(n_panels: usize) -> (u32, u32) {
 ///
 /// `title` goes on top, `x_label` (with units) under the bottom panel; all panels share the x range
 /// of all finite points.
-pub fn write_svg(path: &Path, title: &str, x_label: &str, panels: &[Panel<'_>]) -> Result<(), PlotError> {
+pub fn write_svg(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    panels: &[Panel<'_>],
+) -> Result<(), PlotError> {
     let svg = render_svg(title, x_label, panels)?;
     std::fs::write(path, svg)?;
     Ok(())
@@ -113,11 +127,18 @@ pub fn write_svg(path: &Path, title: &str, x_label: &str, panels: &[Panel<'_>]) 
 
 /// Renders the panels as an SVG document and returns it as a string (see [`write_svg`]).
 pub fn render_svg(title: &str, x_label: &str, panels: &[Panel<'_>]) -> Result<String, PlotError> {
+    let (w, h) = figure_size(panels.len());
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, figure_size(panels.len())).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, (w * RES, h * RES)).into_drawing_area();
         draw_figure(&root, title, x_label, panels)?;
         root.present().map_err(draw_err)?;
+    }
+    // Declare the nominal size; the viewBox written by plotters maps the supersampled coordinates.
+    let drawn = format!("<svg width=\"{}\" height=\"{}\"", w * RES, h * RES);
+    let nominal = format!("<svg width=\"{w}\" height=\"{h}\"");
+    if svg.starts_with(&drawn) {
+        svg.replace_range(..drawn.len(), &nominal);
     }
     Ok(svg)
 }
@@ -129,47 +150,63 @@ fn draw_figure<DB: DrawingBackend>(
     panels: &[Panel<'_>],
 ) -> Result<(), PlotError> {
     root.fill(&WHITE).map_err(draw_err)?;
-    let m = MARGIN as i32;
-    let area = root.margin(m, m, m, m + 8);
+    let m = px(MARGIN);
+    let area = root.margin(m, m, m, m + px(8));
     let area = area
-        .titled(title, ("sans-serif", 24).into_font().style(FontStyle::Bold))
+        .titled(
+            title,
+            ("sans-serif", px(24)).into_font().style(FontStyle::Bold),
+        )
         .map_err(draw_err)?;
     if panels.is_empty() {
         return Ok(());
     }
 
-    let x_range = padded_range(panels.iter().flat_map(|p| p.series).flat_map(|s| s.points).map(|p| p.0), 0.0);
+    let x_range = padded_range(
+        panels
+            .iter()
+            .flat_map(|p| p.series)
+            .flat_map(|s| s.points)
+            .map(|p| p.0),
+        0.0,
+    );
     // Panel bands: equal heights, the bottom one extended by the x axis area so all plot areas match.
-    let breaks: Vec<i32> = (1..panels.len()).map(|i| (i as u32 * PANEL_H) as i32).collect();
+    let breaks: Vec<i32> = (1..panels.len()).map(|i| i as i32 * px(PANEL_H)).collect();
     let bands = area.split_by_breakpoints::<i32, i32, _, _>([], breaks);
 
     let x_fmt = tick_formatter(&x_range);
     for (i, (panel, band)) in panels.iter().zip(&bands).enumerate() {
         let bottom = i + 1 == panels.len();
-        let y_range = padded_range(panel.series.iter().flat_map(|s| s.points).map(|p| p.1), 0.05);
+        let y_range = padded_range(
+            panel.series.iter().flat_map(|s| s.points).map(|p| p.1),
+            0.05,
+        );
         let y_fmt = tick_formatter(&y_range);
 
         let mut chart = ChartBuilder::on(band)
-            .margin_top(8)
-            .margin_bottom(if bottom { 4 } else { 10 })
-            .margin_right(8)
-            .x_label_area_size(if bottom { X_AXIS_H as i32 } else { 0 })
-            .y_label_area_size(Y_AXIS_W as i32)
+            .margin_top(px(8))
+            .margin_bottom(px(if bottom { 4 } else { 10 }))
+            .margin_right(px(8))
+            .x_label_area_size(if bottom { px(X_AXIS_H) } else { 0 })
+            .y_label_area_size(px(Y_AXIS_W))
             .build_cartesian_2d(x_range.clone(), y_range.clone())
             .map_err(draw_err)?;
 
-        let grid_bold = RGBColor(200, 200, 200);
-        let grid_light = RGBColor(235, 235, 235);
-        let text = ("sans-serif", 14).into_font().color(&RGBColor(40, 40, 40));
-        let desc = ("sans-serif", 16).into_font().color(&BLACK);
+        let line = |c: RGBColor| c.stroke_width(RES);
+        let text = ("sans-serif", px(14))
+            .into_font()
+            .color(&RGBColor(40, 40, 40));
+        let desc = ("sans-serif", px(16)).into_font().color(&BLACK);
         let no_label = |_: &f64| String::new();
         let mut mesh = chart.configure_mesh();
         mesh.x_labels(10)
             .y_labels(6)
             .max_light_lines(4)
-            .bold_line_style(grid_bold)
-            .light_line_style(grid_light)
-            .axis_style(RGBColor(90, 90, 90))
+            .bold_line_style(line(RGBColor(205, 205, 205)))
+            .light_line_style(line(RGBColor(238, 238, 238)))
+            .axis_style(line(RGBColor(90, 90, 90)))
+            .set_all_tick_mark_size(px(4))
+            .x_label_offset(0)
             .label_style(text)
             .axis_desc_style(desc)
             .y_desc(panel.y_label)
@@ -185,14 +222,18 @@ fn draw_figure<DB: DrawingBackend>(
         let mut labelled = false;
         for (k, s) in panel.series.iter().enumerate() {
             let color = PALETTE[k % PALETTE.len()];
-            let style = color.stroke_width(2);
+            let style = color.stroke_width(2 * RES);
             let drawn = chart
-                .draw_series(finite_runs(s.points).into_iter().map(|run| PathElement::new(run, style)))
+                .draw_series(
+                    finite_runs(s.points)
+                        .into_iter()
+                        .map(|run| PathElement::new(run, style)),
+                )
                 .map_err(draw_err)?;
             if !s.name.is_empty() {
                 labelled = true;
                 drawn.label(s.name).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 22, y)], color.stroke_width(2))
+                    PathElement::new(vec![(x, y), (x + px(22), y)], color.stroke_width(2 * RES))
                 });
             }
         }
@@ -201,8 +242,10 @@ fn draw_figure<DB: DrawingBackend>(
                 .configure_series_labels()
                 .position(SeriesLabelPosition::UpperRight)
                 .background_style(WHITE.mix(0.9))
-                .border_style(RGBColor(170, 170, 170))
-                .label_font(("sans-serif", 14))
+                .border_style(line(RGBColor(170, 170, 170)))
+                .label_font(("sans-serif", px(14)))
+                .margin(px(10))
+                .legend_area_size(px(30))
                 .draw()
                 .map_err(draw_err)?;
         }
@@ -210,13 +253,19 @@ fn draw_figure<DB: DrawingBackend>(
     Ok(())
 }
 
-/// Splits a polyline into maximal runs of finite points, so gaps in the data show as gaps.
+/// Splits a polyline into maximal runs of finite points, so gaps in the data show as gaps; values are
+/// clipped to ±[`AXIS_LIMIT`].
 fn finite_runs(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
     let mut runs = Vec::new();
     let mut run = Vec::new();
     for &(x, y) in points {
         if x.is_finite() && y.is_finite() {
-            run.push((x, y));
+            // Clip like the axis range does: plotters overflows i32 pixel arithmetic (a panic in debug
+            // builds) on points far outside the chart.
+            run.push((
+                x.clamp(-AXIS_LIMIT, AXIS_LIMIT),
+                y.clamp(-AXIS_LIMIT, AXIS_LIMIT),
+            ));
         } else if !run.is_empty() {
             runs.push(core::mem::take(&mut run));
         }
@@ -227,24 +276,31 @@ fn finite_runs(points: &[(f64, f64)]) -> Vec<Vec<(f64, f64)>> {
     runs
 }
 
-/// Range covering the finite values, widened by `pad` of its span on each side; degenerate or empty
-/// inputs get a non-empty default so the coordinate mapping stays well defined.
+/// Largest magnitude an axis may reach. plotters' tick search misbehaves on infinite spans (it can
+/// loop forever), so data beyond this are clipped to it: the figure stays valid, the curve is cut off.
+const AXIS_LIMIT: f64 = 1e300;
+/// Below this magnitude a constant value is treated as zero when choosing a band around it.
+const TINY: f64 = 1e-200;
+
+/// Range covering the finite values, widened by `pad` of its span on each side. Empty, constant or
+/// nearly constant inputs (span below 1e-9 of the magnitude, where tick placement would be dominated by
+/// round-off) get a band of ±half the magnitude (±1 around zero), so the mapping stays well defined.
 fn padded_range(values: impl Iterator<Item = f64>, pad: f64) -> Range<f64> {
     let (lo, hi) = values
         .filter(|v| v.is_finite())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        .map(|v| v.clamp(-AXIS_LIMIT, AXIS_LIMIT))
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
     if lo > hi {
         return 0.0..1.0;
     }
-    let span = hi - lo;
-    if !span.is_finite() {
-        // Values near ±f64::MAX: halving keeps the arithmetic finite; padding is pointless here.
-        return lo..hi;
-    }
-    if span <= f64::EPSILON * lo.abs().max(hi.abs()) || span == 0.0 {
-        // Constant data: centre it in a band of ±(|value|/2 or 1).
-        let half = if lo == 0.0 { 1.0 } else { 0.5 * lo.abs() };
-        return (lo - half)..(hi + half);
+    let span = hi - lo; // at most 2e300: finite
+    let mag = lo.abs().max(hi.abs());
+    if span < (1e-9 * mag).max(TINY) {
+        let c = 0.5 * (lo + hi);
+        let half = if c.abs() < TINY { 1.0 } else { 0.5 * c.abs() };
+        return (c - half)..(c + half);
     }
     (lo - pad * span)..(hi + pad * span)
 }
@@ -290,11 +346,18 @@ mod tests {
             .duration_since(std::time::UNIX_EPOCH)
             .map(|d| d.as_nanos())
             .unwrap_or(0);
-        std::env::temp_dir().join(format!("mechgen-plot-{tag}-{}-{nanos}.svg", std::process::id()))
+        std::env::temp_dir().join(format!(
+            "mechgen-plot-{tag}-{}-{nanos}.svg",
+            std::process::id()
+        ))
     }
 
     fn looks_like_svg(svg: &str) {
-        assert!(svg.trim_start().starts_with("<svg"), "{}", &svg[..svg.len().min(200)]);
+        assert!(
+            svg.trim_start().starts_with("<svg"),
+            "{}",
+            &svg[..svg.len().min(200)]
+        );
         assert!(svg.trim_end().ends_with("</svg>"));
     }
 
@@ -321,15 +384,24 @@ mod tests {
             &[
                 Panel {
                     y_label: "position (mm)",
-                    series: &[Series { name: "piston.x", points: &pos }],
+                    series: &[Series {
+                        name: "piston.x",
+                        points: &pos,
+                    }],
                 },
                 Panel {
                     y_label: "velocity (m/s)",
-                    series: &[Series { name: "piston.ẋ", points: &vel }],
+                    series: &[Series {
+                        name: "piston.ẋ",
+                        points: &vel,
+                    }],
                 },
                 Panel {
                     y_label: "acceleration (mm/s²)",
-                    series: &[Series { name: "piston.ẍ", points: &acc }],
+                    series: &[Series {
+                        name: "piston.ẍ",
+                        points: &acc,
+                    }],
                 },
             ],
         )
@@ -363,15 +435,48 @@ mod tests {
         let constant = [(5.0, 7.0), (6.0, 7.0)];
         let all_bad = [(nan, nan), (inf, -inf)];
         let huge = [(0.0, f64::MAX), (1.0, -f64::MAX)];
-        let gaps = [Series { name: "a", points: &weird }, Series { name: "", points: &constant }];
-        let bad = [Series { name: "bad", points: &all_bad }];
-        let big = [Series { name: "huge", points: &huge }];
+        let nearly_constant = [(0.0, 1.0), (1.0, 1.0 + 1e-13), (1e-300, 1.0)];
+        let tiny = [(1e-250, 1e-250), (2e-250, 3e-250)];
+        let gaps = [
+            Series {
+                name: "a",
+                points: &weird,
+            },
+            Series {
+                name: "",
+                points: &constant,
+            },
+        ];
+        let bad = [Series {
+            name: "bad",
+            points: &all_bad,
+        }];
+        let big = [Series {
+            name: "huge",
+            points: &huge,
+        }];
+        let small = [
+            Series {
+                name: "nearly constant",
+                points: &nearly_constant,
+            },
+            Series {
+                name: "tiny",
+                points: &tiny,
+            },
+        ];
         let cases: Vec<Vec<Panel<'_>>> = vec![
             vec![],
-            vec![Panel { y_label: "empty", series: &[] }],
+            vec![Panel {
+                y_label: "empty",
+                series: &[],
+            }],
             vec![Panel {
                 y_label: "empty series",
-                series: &[Series { name: "none", points: &[] }],
+                series: &[Series {
+                    name: "none",
+                    points: &[],
+                }],
             }],
             vec![
                 Panel {
@@ -385,6 +490,10 @@ mod tests {
                 Panel {
                     y_label: "huge",
                     series: &big,
+                },
+                Panel {
+                    y_label: "small",
+                    series: &small,
                 },
             ],
         ];
@@ -404,7 +513,13 @@ mod tests {
 
     #[test]
     fn finite_runs_break_at_gaps() {
-        let runs = finite_runs(&[(0.0, 0.0), (1.0, f64::NAN), (2.0, 2.0), (3.0, 3.0), (f64::INFINITY, 0.0)]);
+        let runs = finite_runs(&[
+            (0.0, 0.0),
+            (1.0, f64::NAN),
+            (2.0, 2.0),
+            (3.0, 3.0),
+            (f64::INFINITY, 0.0),
+        ]);
         assert_eq!(runs, vec![vec![(0.0, 0.0)], vec![(2.0, 2.0), (3.0, 3.0)]]);
     }
 
@@ -413,6 +528,7 @@ mod tests {
         assert_eq!(padded_range([].into_iter(), 0.1), 0.0..1.0);
         assert_eq!(padded_range([2.0, 2.0].into_iter(), 0.1), 1.0..3.0);
         assert_eq!(padded_range([0.0].into_iter(), 0.1), -1.0..1.0);
+        assert_eq!(padded_range([f64::MAX, 0.0].into_iter(), 0.0), 0.0..1e300);
         let f = tick_formatter(&(0.0..360.0));
         assert_eq!(f(&90.0), "90");
         let f = tick_formatter(&(-2.0e6..2.0e6));

@@ -561,7 +561,7 @@ mod tests {
     use crate::parse::parse_str;
 
     fn errors(source: &str) -> Vec<String> {
-        let spec = parse_str(source).ok().expect("syntax");
+        let spec = parse_str(source).unwrap_or_else(|e| panic!("syntax: {e}"));
         match check(&spec) {
             Ok(_) => Vec::new(),
             Err(e) => e.messages(),
@@ -587,9 +587,8 @@ mod tests {
     #[test]
     fn a_valid_scene_checks() {
         let spec = parse_str(&scene("driver d: angle(crank) = w * t;"))
-            .ok()
-            .expect("parses");
-        let model = check(&spec).ok().expect("checks");
+            .unwrap_or_else(|e| panic!("parses: {e}"));
+        let model = check(&spec).unwrap_or_else(|e| panic!("checks: {e}"));
         assert_eq!(model.dim(), 12);
         assert_eq!(model.equation_names().len(), 12);
         assert_eq!(model.equation_names()[0], "frame.x");

@@ -448,7 +448,7 @@ mod tests {
     }
 
     fn expr(s: &str) -> String {
-        show(&syn::parse_str::<Expr>(s).ok().expect("parses"))
+        show(&syn::parse_str::<Expr>(s).unwrap_or_else(|e| panic!("parses: {e}")))
     }
 
     #[test]
@@ -477,8 +477,7 @@ mod tests {
                 driver spin: angle(crank) = omega * t;
             }",
         )
-        .ok()
-        .expect("parses");
+        .unwrap_or_else(|e| panic!("parses: {e}"));
         assert_eq!(spec.name, "PistonCrank");
         assert_eq!(spec.docs.len(), 1);
         assert_eq!(spec.params.len(), 1);

@@ -49,10 +49,10 @@ fn macro_bodies(file: TokenStream) -> Vec<TokenStream> {
 fn mechanism_name(scene: &TokenStream) -> String {
     let mut tokens = scene.clone().into_iter();
     while let Some(token) = tokens.next() {
-        if matches!(&token, TokenTree::Ident(i) if i == "mechanism") {
-            if let Some(TokenTree::Ident(name)) = tokens.next() {
-                return name.to_string();
-            }
+        if matches!(&token, TokenTree::Ident(i) if i == "mechanism")
+            && let Some(TokenTree::Ident(name)) = tokens.next()
+        {
+            return name.to_string();
         }
     }
     panic!("no `mechanism NAME` in scene: {scene}");
