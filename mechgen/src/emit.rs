@@ -76,7 +76,7 @@ pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
             .map(|e| (matrix_target(&target, e.row, e.col), e.value))
             .collect();
         let clear = if kin.jacobian.len() < n * n {
-            quote! { #target.fill(0.0); }
+            quote! { #target.as_mut_slice().fill(0.0); }
         } else {
             TokenStream::new()
         };
@@ -331,10 +331,11 @@ fn matrix_target(target: &TokenStream, row: usize, col: usize) -> TokenStream {
     quote!(#target[(#r, #c)])
 }
 
-/// `target.fill(0.0);` if some of `values` are identically zero (only non-zeros are written).
+/// Clears `target` if some of `values` are identically zero (only non-zeros are written).
 fn clear_if_sparse(arena: &Arena, values: &[Id], target: &TokenStream) -> TokenStream {
     if values.iter().any(|&v| arena.is_zero(v)) {
-        quote! { #target.fill(0.0); }
+        // Slice fill: nalgebra's `fill` goes element by element, ~18× slower for a 15 × 15.
+        quote! { #target.as_mut_slice().fill(0.0); }
     } else {
         TokenStream::new()
     }

@@ -156,21 +156,25 @@ where
             });
         }
 
+        // Plain slices, column-major (a[i + j·n] is row i, column j): nalgebra's element
+        // iterators and tuple indexing cost an order of magnitude more in these loops.
+        let a = self.lu.as_mut_slice();
         let mut largest = 0.0_f64;
-        for &a in self.lu.iter() {
-            if !a.is_finite() {
+        for &x in a.iter() {
+            if !x.is_finite() {
                 return Err(LuError::NonFinite);
             }
-            largest = largest.max(a.abs());
+            largest = largest.max(x.abs());
         }
         // `n as f64` is exact for any size that fits in memory.
         let threshold = self.pivot_tolerance * n as f64 * largest;
         let (mut min_pivot, mut max_pivot) = (f64::INFINITY, 0.0_f64);
 
         for k in 0..n {
-            let (mut pivot_row, mut best) = (k, self.lu[(k, k)].abs());
+            let column_k = k * n;
+            let (mut pivot_row, mut best) = (k, a[column_k + k].abs());
             for i in k + 1..n {
-                let candidate = self.lu[(i, k)].abs();
+                let candidate = a[column_k + i].abs();
                 if candidate > best {
                     (pivot_row, best) = (i, candidate);
                 }
@@ -184,21 +188,26 @@ where
                 });
             }
             self.swaps[k] = pivot_row;
-            self.lu.swap_rows(k, pivot_row);
+            if pivot_row != k {
+                for j in 0..n {
+                    a.swap(j * n + k, j * n + pivot_row);
+                }
+            }
             (min_pivot, max_pivot) = (min_pivot.min(best), max_pivot.max(best));
 
-            let pivot = self.lu[(k, k)];
+            let pivot = a[column_k + k];
             for i in k + 1..n {
-                self.lu[(i, k)] /= pivot;
+                a[column_k + i] /= pivot;
             }
-            // Column-oriented update (nalgebra is column-major); Jacobians are sparse, so whole
-            // columns are skipped when the pivot row has a structural zero there.
-            for j in k + 1..n {
-                let u_kj = self.lu[(k, j)];
+            // Column-oriented update; Jacobians are sparse, so whole columns are skipped when the
+            // pivot row has a structural zero there.
+            let (left, right) = a.split_at_mut(column_k + n);
+            let l = &left[column_k + k + 1..column_k + n];
+            for column in right.chunks_exact_mut(n) {
+                let u_kj = column[k];
                 if u_kj != 0.0 {
-                    for i in k + 1..n {
-                        let l_ik = self.lu[(i, k)];
-                        self.lu[(i, j)] -= l_ik * u_kj;
+                    for (x, &l_ik) in column[k + 1..].iter_mut().zip(l) {
+                        *x -= l_ik * u_kj;
                     }
                 }
             }
@@ -223,22 +232,26 @@ where
                 found: b.nrows(),
             });
         }
-        for (k, &swap) in self.swaps.iter().enumerate() {
-            b.swap_rows(k, swap);
+        let (a, x) = (self.lu.as_slice(), b.as_mut_slice());
+        for (k, &swap) in self.swaps.as_slice().iter().enumerate() {
+            x.swap(k, swap);
         }
+        // Forward substitution with unit-diagonal L, then back substitution with U, by columns.
         for k in 0..n {
-            let b_k = b[k];
-            if b_k != 0.0 {
+            let x_k = x[k];
+            if x_k != 0.0 {
+                let column = &a[k * n..(k + 1) * n];
                 for i in k + 1..n {
-                    b[i] -= self.lu[(i, k)] * b_k;
+                    x[i] -= column[i] * x_k;
                 }
             }
         }
         for k in (0..n).rev() {
-            b[k] /= self.lu[(k, k)];
-            let x_k = b[k];
+            let column = &a[k * n..(k + 1) * n];
+            x[k] /= column[k];
+            let x_k = x[k];
             for i in 0..k {
-                b[i] -= self.lu[(i, k)] * x_k;
+                x[i] -= column[i] * x_k;
             }
         }
         Ok(())

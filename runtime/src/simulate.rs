@@ -79,11 +79,19 @@ where
     /// The [`SolveError`] of the solve at `t`; the simulation stays at the previous state.
     pub fn step_to(&mut self, t: f64) -> Result<&State<M>, SolveError> {
         let (current, next) = (&self.current, &mut self.next);
-        next.q.copy_from(&current.q);
         let h = t - current.t;
-        if self.predictor && h.is_finite() {
-            next.q.axpy(h, &current.qd, 1.0);
-            next.q.axpy(0.5 * h * h, &current.qdd, 1.0);
+        let predict = self.predictor && h.is_finite();
+        let (q, qd, qdd) = (
+            current.q.as_slice(),
+            current.qd.as_slice(),
+            current.qdd.as_slice(),
+        );
+        for (k, guess) in next.q.as_mut_slice().iter_mut().enumerate() {
+            *guess = if predict {
+                q[k] + h * qd[k] + 0.5 * h * h * qdd[k]
+            } else {
+                q[k]
+            };
         }
         self.solver.solve_into(t, next)?;
         core::mem::swap(&mut self.current, &mut self.next);

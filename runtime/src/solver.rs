@@ -147,7 +147,7 @@ where
                 lu.factor_with(|jacobian| mechanism.phi_and_jacobian(q, t, phi, jacobian));
             check_finite(phi, t, Quantity::Phi)?;
             factored.map_err(|error| lu_error(error, t))?;
-            let residual = phi.amax();
+            let residual = max_abs(phi);
             if converged {
                 return Ok(Convergence {
                     iterations,
@@ -165,11 +165,11 @@ where
 
             lu.solve_in_place(phi).map_err(|error| lu_error(error, t))?;
             // `phi` now holds Φ_q⁻¹ Φ = −Δq.
-            let step = phi.amax();
+            let step = max_abs(phi);
             if !step.is_finite() {
                 return Err(non_finite(t, Quantity::Step));
             }
-            let scale = q.amax().max(1.0);
+            let scale = max_abs(q).max(1.0);
             converged = residual <= options.residual_tolerance * scale
                 && step <= options.step_tolerance * scale;
             *q -= &*phi;
@@ -304,6 +304,14 @@ where
     }
 }
 
+/// ‖v‖∞ over the contiguous storage (nalgebra's `amax` iterates element by element, slowly).
+fn max_abs<D: Dim>(v: &Vector<D>) -> f64
+where
+    DefaultAllocator: Storage<D>,
+{
+    v.as_slice().iter().fold(0.0, |m, x| m.max(x.abs()))
+}
+
 fn non_finite(time: f64, quantity: Quantity) -> SolveError {
     SolveError::NonFinite { time, quantity }
 }
@@ -312,7 +320,7 @@ fn check_finite<D: Dim>(v: &Vector<D>, t: f64, quantity: Quantity) -> Result<(),
 where
     DefaultAllocator: Storage<D>,
 {
-    if v.iter().all(|x| x.is_finite()) {
+    if v.as_slice().iter().all(|x| x.is_finite()) {
         Ok(())
     } else {
         Err(non_finite(t, quantity))
