@@ -88,13 +88,10 @@ mod tests {
 
     #[test]
     fn rejects_beyond_the_limits() {
-        let deep = check(&nested(MAX_DEPTH))
-            .err()
-            .expect("too deep")
-            .to_string();
+        let deep = check(&nested(MAX_DEPTH)).expect_err("too deep").to_string();
         assert!(deep.contains("nested more than 64"), "{deep}");
         let long = format!("mechanism M {{ param p = 1{}; }}", "+1".repeat(5000));
-        let long = check(&long).err().expect("too long").to_string();
+        let long = check(&long).expect_err("too long").to_string();
         assert!(long.contains("longer than 10000 tokens"), "{long}");
     }
 }
