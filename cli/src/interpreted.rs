@@ -117,7 +117,8 @@ impl Interpreted {
     }
 
     fn write_jacobian(&self, values: &[f64], out: &mut Matrix<Dyn>) {
-        out.fill(0.0);
+        // Slice fill: nalgebra's `fill` goes element by element.
+        out.as_mut_slice().fill(0.0);
         for (&(row, col), &value) in self.pattern.iter().zip(values) {
             out[(row, col)] = value;
         }

@@ -107,3 +107,33 @@ pub fn pretty(tokens: TokenStream) -> String {
         Err(_) => tokens.to_string(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// Same input, byte-identical output: every arena and name table below is a fresh
+    /// `HashMap`/`HashSet` with its own random seed, so any hash-order dependence would show.
+    #[test]
+    fn expansion_is_deterministic() {
+        let source = "/// Doc.
+            pub mechanism M {
+                param w = 2;
+                ground frame at (0, 0, 0);
+                body crank near (0, 0, 0);
+                body slider near (3, 0, 0);
+                joint pivot: revolute(frame, crank);
+                joint guide: prismatic(frame, slider, along (1, 0));
+                joint rod: distance(crank @ (1, 0), slider, 2.5);
+                driver spin: angle(crank) = w * t + sin(t)^2;
+            }";
+        let expand = || {
+            let tokens: proc_macro2::TokenStream = source.parse().expect("lexes");
+            super::expand(tokens)
+                .unwrap_or_else(|e| panic!("{e}"))
+                .to_string()
+        };
+        let first = expand();
+        for _ in 0..5 {
+            assert_eq!(expand(), first);
+        }
+    }
+}
