@@ -17,9 +17,32 @@ use crate::kinematics::Kinematics;
 use crate::model::{COORDINATE_SUFFIXES, Model};
 use crate::stats::OpCounts;
 
+/// Choices that shape the generated code without changing its meaning.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CodegenOptions {
+    /// Largest number of operations (DAG nodes) one generated function body may hold; longer
+    /// bodies are split into helper functions of about this size. rustc's compile time grows
+    /// much faster than linearly in the size of one function, so huge scenes need this.
+    pub max_function_size: usize,
+}
+
+impl Default for CodegenOptions {
+    fn default() -> Self {
+        Self {
+            max_function_size: 2_000,
+        }
+    }
+}
+
+/// Emits the whole item set for a scene with default options (see [`emit_with`]).
+pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
+    emit_with(model, kin, &CodegenOptions::default())
+}
+
 /// Emits the whole item set for a scene: the parameter struct, its constants, the `Mechanism`
 /// implementation and the named body accessors.
-pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
+pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> TokenStream {
+    let _ = options;
     let name = &model.name;
     let vis = &model.vis;
     let docs = &model.docs;

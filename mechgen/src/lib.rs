@@ -27,6 +27,7 @@ pub mod stats;
 
 use proc_macro2::TokenStream;
 
+pub use emit::CodegenOptions;
 pub use error::Errors;
 pub use kinematics::Kinematics;
 pub use model::Model;
@@ -87,6 +88,19 @@ pub fn expand_or_errors(tokens: TokenStream) -> TokenStream {
         )
         .to_compile_error(),
     }
+}
+
+/// Generated code for a `.mech` source with explicit options, as tokens: what a `build.rs`
+/// writes into `OUT_DIR` (see the `builder` module for assembling large scenes in code).
+///
+/// # Errors
+/// As [`compile_str`].
+pub fn expand_str_with(
+    source: &str,
+    options: &emit::CodegenOptions,
+) -> Result<TokenStream, Errors> {
+    let scene = compile_str(source)?;
+    Ok(emit::emit_with(&scene.model, &scene.kinematics, options))
 }
 
 /// Generated code for a `.mech` source, formatted for reading (CLI `expand`, snapshots).

@@ -296,7 +296,11 @@ fn max_abs_if_finite(values: &[f64]) -> Option<f64> {
     for &x in chunks.remainder() {
         let magnitude = x.abs();
         finite &= magnitude <= f64::MAX;
-        largest[0] = if magnitude > largest[0] { magnitude } else { largest[0] };
+        largest[0] = if magnitude > largest[0] {
+            magnitude
+        } else {
+            largest[0]
+        };
     }
     let [a, b, c, d] = largest;
     finite.then(|| a.max(b).max(c.max(d)))
@@ -310,9 +314,15 @@ mod tests {
     fn max_abs_if_finite_handles_every_length_and_non_finite_values() {
         assert_eq!(max_abs_if_finite(&[]), Some(0.0));
         assert_eq!(max_abs_if_finite(&[-3.0]), Some(3.0));
-        assert_eq!(max_abs_if_finite(&[1.0, -2.0, 0.5, 4.0, -7.5, 0.0]), Some(7.5));
+        assert_eq!(
+            max_abs_if_finite(&[1.0, -2.0, 0.5, 4.0, -7.5, 0.0]),
+            Some(7.5)
+        );
         assert_eq!(max_abs_if_finite(&[1.0, f64::NAN, 0.5, 4.0, 2.0]), None);
-        assert_eq!(max_abs_if_finite(&[1.0, 2.0, 3.0, 4.0, f64::NEG_INFINITY]), None);
+        assert_eq!(
+            max_abs_if_finite(&[1.0, 2.0, 3.0, 4.0, f64::NEG_INFINITY]),
+            None
+        );
     }
     use nalgebra::{Matrix3, U3, Vector3};
 
