@@ -9,7 +9,10 @@ use std::cell::RefCell;
 use mechgen::Scene;
 use mechgen::interpret::{Inputs, Tape};
 use mechgen_runtime::nalgebra::Dyn;
-use mechgen_runtime::{Matrix, Mechanism, ParameterError, Vector};
+use mechgen_runtime::{
+    Accelerations, Lu, Matrix, Mechanism, Outputs, ParameterError, SolveError, Vector, Velocities,
+    solve_accelerations, solve_velocities,
+};
 
 /// A scene whose kinematics are interpreted rather than generated.
 #[derive(Debug, Clone)]
@@ -23,8 +26,10 @@ pub struct Interpreted {
     phi: Tape,
     jacobian: Tape,
     phi_and_jacobian: Tape,
-    nu: Tape,
-    gamma: Tape,
+    /// ν and γ, present when the scene asked for them.
+    nu: Option<Tape>,
+    gamma: Option<Tape>,
+    outputs: Outputs,
     /// Structural non-zeros of Φ_q, in the order the Jacobian tape produces them.
     pattern: Vec<(usize, usize)>,
     /// Tape slots and output values, reused by every call (evaluation is `&self`).
@@ -54,12 +59,23 @@ impl Interpreted {
             Tape::new(arena, &kin.phi),
             Tape::new(arena, &jacobian_values),
             Tape::new(arena, &both),
-            Tape::new(arena, &kin.nu),
-            Tape::new(arena, &kin.gamma),
         ];
-        let slots = tapes.iter().map(Tape::len).max().unwrap_or(0);
+        let nu = kin.nu.as_deref().map(|nu| Tape::new(arena, nu));
+        let gamma = kin.gamma.as_deref().map(|gamma| Tape::new(arena, gamma));
+        let slots = tapes
+            .iter()
+            .chain(&nu)
+            .chain(&gamma)
+            .map(Tape::len)
+            .max()
+            .unwrap_or(0);
         let values = both.len().max(model.dim());
-        let [guess, phi, jacobian, phi_and_jacobian, nu, gamma] = tapes;
+        let [guess, phi, jacobian, phi_and_jacobian] = tapes;
+        let outputs = match model.outputs {
+            mechgen::model::Outputs::Positions => Outputs::Positions,
+            mechgen::model::Outputs::Velocities => Outputs::Velocities,
+            mechgen::model::Outputs::Accelerations => Outputs::Accelerations,
+        };
         Interpreted {
             name: model.name.to_string(),
             coordinates: model.coordinate_names(),
@@ -72,6 +88,7 @@ impl Interpreted {
             phi_and_jacobian,
             nu,
             gamma,
+            outputs,
             pattern: kin.jacobian.iter().map(|e| (e.row, e.col)).collect(),
             scratch: RefCell::new(Scratch {
                 slots: vec![0.0; slots],
@@ -206,17 +223,49 @@ impl Mechanism for Interpreted {
         );
     }
 
-    fn nu(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
-        self.run(&self.nu, self.inputs(q.as_slice(), &[], t), |v| {
-            copy_into(v, out)
-        });
+    fn outputs(&self) -> Outputs {
+        self.outputs
     }
 
+    fn derivatives(
+        &self,
+        q: &Vector<Dyn>,
+        t: f64,
+        factors: &Lu<Dyn>,
+        qd: &mut Vector<Dyn>,
+        qdd: &mut Vector<Dyn>,
+    ) -> Result<(), SolveError> {
+        if self.outputs >= Outputs::Velocities {
+            solve_velocities(self, q, t, factors, qd)?;
+        }
+        if self.outputs >= Outputs::Accelerations {
+            solve_accelerations(self, q, qd, t, factors, qdd)?;
+        }
+        Ok(())
+    }
+}
+
+/// One interpreter type serves every scene, so it implements the derivative traits for all;
+/// a scene that did not ask for an output writes NaN there, and [`Mechanism::derivatives`]
+/// never asks for it.
+impl Velocities for Interpreted {
+    fn nu(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
+        match &self.nu {
+            Some(tape) => self.run(tape, self.inputs(q.as_slice(), &[], t), |v| {
+                copy_into(v, out)
+            }),
+            None => out.as_mut_slice().fill(f64::NAN),
+        }
+    }
+}
+
+impl Accelerations for Interpreted {
     fn gamma(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
-        self.run(
-            &self.gamma,
-            self.inputs(q.as_slice(), qd.as_slice(), t),
-            |v| copy_into(v, out),
-        );
+        match &self.gamma {
+            Some(tape) => self.run(tape, self.inputs(q.as_slice(), qd.as_slice(), t), |v| {
+                copy_into(v, out);
+            }),
+            None => out.as_mut_slice().fill(f64::NAN),
+        }
     }
 }

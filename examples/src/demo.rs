@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use mechgen_runtime::nalgebra::Const;
-use mechgen_runtime::{Mechanism, Simulation, SolveError, Solver, State, write_csv_header};
+use mechgen_runtime::{
+    Accelerations, Mechanism, Simulation, SolveError, Solver, State, write_csv_header,
+};
 
 use crate::accuracy::{ErrorTracker, RelativeErrors};
 use crate::closed_form::Kinematics;
@@ -82,7 +84,7 @@ pub fn revolution<M, const N: usize>(
     exact: impl Fn(f64) -> Kinematics<N>,
 ) -> Result<Revolution<M, N>, SolveError>
 where
-    M: Mechanism<Dim = Const<N>> + Clone,
+    M: Accelerations<Dim = Const<N>> + Clone,
 {
     let mut states = Vec::with_capacity(steps + 1);
     let mut simulation = Simulation::new(Solver::new(mechanism.clone()), 0.0)?;
@@ -105,8 +107,8 @@ where
         let reference = exact(state.t);
         tracker.add(
             state.q.as_slice(),
-            state.qd.as_slice(),
-            state.qdd.as_slice(),
+            state.qd().as_slice(),
+            state.qdd().as_slice(),
             &reference,
         );
     }

@@ -57,3 +57,30 @@ mechanism! {
         driver crank_angle: angle(crank) = omega * t;
     }
 }
+
+mechanism! {
+    /// Offset slider-crank posed by a parameter: a positions-only, time-free scene (what an
+    /// optimiser or a kinematic calibration calls millions of times). Units mm, rad.
+    ///
+    /// No velocities, accelerations or time derivatives are generated for it.
+    pub mechanism OffsetSlider {
+        /// Crank angle (rad), set before each solve.
+        param crank_angle = 0.5;
+        /// Offset of the slider's line above the crank pivot (mm).
+        param offset = 12.0;
+
+        ground frame at (0, 0, 0);
+        body crank near (0, 0, 0.5);
+        body rod near (26, 18, -0.2);
+        body slider near (100, 12, 0);
+
+        joint pivot: revolute(frame, crank);
+        joint crank_pin: revolute(crank @ (30, 0), rod);
+        joint wrist_pin: revolute(rod @ (80, 0), slider);
+        joint guide: prismatic(frame @ (0, offset), slider, along (1, 0));
+
+        driver pose: angle(crank) = crank_angle;
+
+        outputs positions;
+    }
+}

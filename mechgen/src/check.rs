@@ -11,7 +11,7 @@ use syn::Ident;
 
 use crate::error::Errors;
 use crate::expr::{Arena, Func, Id, Var};
-use crate::model::{Body, Constraint, ConstraintKind, Driven, Model, Param, Point};
+use crate::model::{Body, Constraint, ConstraintKind, Driven, Model, Outputs, Param, Point};
 use crate::spec::{BinOp, DriverKind, Expr, ExprKind, JointKind, PointRef, Spec};
 
 /// Checks a spec and builds its model.
@@ -30,6 +30,7 @@ pub fn check(spec: &Spec) -> Result<Model, Errors> {
         ground: Vec::new(),
     };
     cx.check_names(spec);
+    let outputs = cx.outputs(spec);
 
     let params: Vec<Param> = spec
         .params
@@ -97,6 +98,7 @@ pub fn check(spec: &Spec) -> Result<Model, Errors> {
         params,
         bodies,
         constraints,
+        outputs,
     })
 }
 
@@ -156,6 +158,34 @@ impl Checker {
                 "the mechanism has no moving body; declare one with `body NAME near (x, y, angle);`",
             );
         }
+    }
+
+    /// `outputs positions[, velocities[, accelerations]];`: a prefix of the three levels, in
+    /// order, since each needs the one before (velocities solve at the positions, …).
+    fn outputs(&mut self, spec: &Spec) -> Outputs {
+        let Some(names) = &spec.outputs else {
+            return Outputs::Accelerations;
+        };
+        for (k, name) in names.iter().enumerate() {
+            let expected = Outputs::NAMES.get(k);
+            if expected.is_some_and(|e| name == e) {
+                continue;
+            }
+            let message = if !Outputs::NAMES.contains(&name.to_string().as_str()) {
+                format!(
+                    "unknown output `{name}`; the outputs are `positions`, `velocities` and \
+                     `accelerations`"
+                )
+            } else {
+                "list outputs in order, each with the ones it needs: `outputs positions;`, \
+                 `outputs positions, velocities;` or `outputs positions, velocities, \
+                 accelerations;`"
+                    .to_owned()
+            };
+            self.errors.push(name.span(), message);
+            return Outputs::Accelerations;
+        }
+        Outputs::ALL[names.len().clamp(1, 3) - 1]
     }
 
     fn body(&mut self, name: &Ident) -> Option<usize> {

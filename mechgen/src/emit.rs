@@ -14,7 +14,7 @@ use quote::{format_ident, quote};
 use crate::expr::{Arena, Func, Id, Node, Var};
 use crate::interpret::topological_order;
 use crate::kinematics::Kinematics;
-use crate::model::{COORDINATE_SUFFIXES, Model};
+use crate::model::{COORDINATE_SUFFIXES, Model, Outputs};
 use crate::stats::OpCounts;
 
 /// Choices that shape the generated code without changing its meaning.
@@ -124,14 +124,14 @@ pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> T
         clear.extend(jac_clear);
         cx.function(&outputs, clear)
     };
-    let nu = {
-        let (outputs, clear) = vector(&kin.nu, quote!(out));
+    let nu = kin.nu.as_deref().map(|nu| {
+        let (outputs, clear) = vector(nu, quote!(out));
         cx.function(&outputs, clear)
-    };
-    let gamma = {
-        let (outputs, clear) = vector(&kin.gamma, quote!(out));
+    });
+    let gamma = kin.gamma.as_deref().map(|gamma| {
+        let (outputs, clear) = vector(gamma, quote!(out));
         cx.function(&outputs, clear)
-    };
+    });
 
     let guess_body = guess.body;
     let (phi_doc, phi_body, phi_args) = (phi.doc("Φ(q, t)"), phi.body, phi.args);
@@ -141,13 +141,64 @@ pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> T
         phi_and_jacobian.body,
         phi_and_jacobian.args,
     );
-    let (nu_doc, nu_body, nu_args) = (nu.doc("ν = −Φ_t"), nu.body, nu.args);
-    let (gamma_doc, gamma_body, gamma_args) = (gamma.doc("γ(q, q̇, t)"), gamma.body, gamma.args);
     let [phi_q, _, phi_t] = phi_args;
     let [jac_q, _, jac_t] = jac_args;
     let [pj_q, _, pj_t] = pj_args;
-    let [nu_q, _, nu_t] = nu_args;
-    let [gamma_q, gamma_qd, gamma_t] = gamma_args;
+    let velocities_impl = nu.map(|nu| {
+        let (doc, body, [q, _, t]) = (nu.doc("ν = −Φ_t"), nu.body, nu.args);
+        quote! {
+            impl ::mechgen_runtime::Velocities for #name {
+                #doc
+                fn nu(
+                    &self,
+                    #q: &::mechgen_runtime::Vector<Self::Dim>,
+                    #t: f64,
+                    out: &mut ::mechgen_runtime::Vector<Self::Dim>,
+                ) {
+                    #body
+                }
+            }
+        }
+    });
+    let accelerations_impl = gamma.map(|gamma| {
+        let (doc, body, [q, qd, t]) = (gamma.doc("γ(q, q̇, t)"), gamma.body, gamma.args);
+        quote! {
+            impl ::mechgen_runtime::Accelerations for #name {
+                #doc
+                fn gamma(
+                    &self,
+                    #q: &::mechgen_runtime::Vector<Self::Dim>,
+                    #qd: &::mechgen_runtime::Vector<Self::Dim>,
+                    #t: f64,
+                    out: &mut ::mechgen_runtime::Vector<Self::Dim>,
+                ) {
+                    #body
+                }
+            }
+        }
+    });
+    // The derivative solves the scene asked for; unused arguments get a leading underscore.
+    let (outputs_variant, derivative_args, derivatives_body) = match model.outputs {
+        Outputs::Positions => (
+            quote!(Positions),
+            ["_q", "_t", "_factors", "_qd", "_qdd"],
+            quote! { ::core::result::Result::Ok(()) },
+        ),
+        Outputs::Velocities => (
+            quote!(Velocities),
+            ["q", "t", "factors", "qd", "_qdd"],
+            quote! { ::mechgen_runtime::solve_velocities(self, q, t, factors, qd) },
+        ),
+        Outputs::Accelerations => (
+            quote!(Accelerations),
+            ["q", "t", "factors", "qd", "qdd"],
+            quote! {
+                ::mechgen_runtime::solve_velocities(self, q, t, factors, qd)?;
+                ::mechgen_runtime::solve_accelerations(self, q, qd, t, factors, qdd)
+            },
+        ),
+    };
+    let [d_q, d_t, d_factors, d_qd, d_qdd] = derivative_args.map(|a| format_ident!("{}", a));
 
     let bodies_trait = format_ident!("{}Bodies", name);
     let bodies_doc = format!(
@@ -158,26 +209,37 @@ pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> T
             .find(|b| !b.ground)
             .map_or("body".to_owned(), |b| b.name.to_string())
     );
+    let (view, what) = match model.outputs {
+        Outputs::Positions => (quote!(Pose), "Pose"),
+        Outputs::Velocities => (quote!(PoseVelocity), "Pose and velocity"),
+        Outputs::Accelerations => (quote!(BodyState), "Pose, velocity and acceleration"),
+    };
     let accessor_decls = model.bodies.iter().map(|b| {
         let ident = &b.name;
         let docs = if b.docs.is_empty() {
-            let doc = format!(" Pose, velocity and acceleration of `{ident}`.");
+            let doc = format!(" {what} of `{ident}`.");
             quote! { #[doc = #doc] }
         } else {
             let docs = &b.docs;
             quote! { #(#docs)* }
         };
-        quote! { #docs fn #ident(&self) -> ::mechgen_runtime::BodyState; }
+        quote! { #docs fn #ident(&self) -> ::mechgen_runtime::#view; }
     });
     let accessor_impls = model.bodies.iter().enumerate().map(|(i, b)| {
         let ident = &b.name;
         let [x, y, th] = [3 * i, 3 * i + 1, 3 * i + 2].map(idx);
+        let velocity = (model.outputs >= Outputs::Velocities).then(|| {
+            quote! { x_dot: self.qd()[#x], y_dot: self.qd()[#y], theta_dot: self.qd()[#th], }
+        });
+        let acceleration = (model.outputs >= Outputs::Accelerations).then(|| {
+            quote! { x_ddot: self.qdd()[#x], y_ddot: self.qdd()[#y], theta_ddot: self.qdd()[#th], }
+        });
         quote! {
-            fn #ident(&self) -> ::mechgen_runtime::BodyState {
-                ::mechgen_runtime::BodyState {
+            fn #ident(&self) -> ::mechgen_runtime::#view {
+                ::mechgen_runtime::#view {
                     x: self.q[#x], y: self.q[#y], theta: self.q[#th],
-                    x_dot: self.qd[#x], y_dot: self.qd[#y], theta_dot: self.qd[#th],
-                    x_ddot: self.qdd[#x], y_ddot: self.qdd[#y], theta_ddot: self.qdd[#th],
+                    #velocity
+                    #acceleration
                 }
             }
         }
@@ -299,27 +361,25 @@ pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> T
                 #pj_body
             }
 
-            #nu_doc
-            fn nu(
-                &self,
-                #nu_q: &::mechgen_runtime::Vector<Self::Dim>,
-                #nu_t: f64,
-                out: &mut ::mechgen_runtime::Vector<Self::Dim>,
-            ) {
-                #nu_body
+            fn outputs(&self) -> ::mechgen_runtime::Outputs {
+                ::mechgen_runtime::Outputs::#outputs_variant
             }
 
-            #gamma_doc
-            fn gamma(
+            fn derivatives(
                 &self,
-                #gamma_q: &::mechgen_runtime::Vector<Self::Dim>,
-                #gamma_qd: &::mechgen_runtime::Vector<Self::Dim>,
-                #gamma_t: f64,
-                out: &mut ::mechgen_runtime::Vector<Self::Dim>,
-            ) {
-                #gamma_body
+                #d_q: &::mechgen_runtime::Vector<Self::Dim>,
+                #d_t: f64,
+                #d_factors: &::mechgen_runtime::Lu<Self::Dim>,
+                #d_qd: &mut ::mechgen_runtime::Vector<Self::Dim>,
+                #d_qdd: &mut ::mechgen_runtime::Vector<Self::Dim>,
+            ) -> ::core::result::Result<(), ::mechgen_runtime::SolveError> {
+                #derivatives_body
             }
         }
+
+        #velocities_impl
+
+        #accelerations_impl
 
         #[doc = #bodies_doc]
         #vis trait #bodies_trait {

@@ -8,7 +8,7 @@
 
 use crate::diff::Differentiator;
 use crate::expr::{Arena, Id, Var};
-use crate::model::{ConstraintKind, Driven, Model, Point};
+use crate::model::{ConstraintKind, Driven, Model, Outputs, Point};
 
 /// A structural non-zero of the Jacobian.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -28,10 +28,10 @@ pub struct Kinematics {
     pub phi: Vec<Id>,
     /// Φ_q's structural non-zeros, row-major.
     pub jacobian: Vec<Entry>,
-    /// ν = −Φ_t.
-    pub nu: Vec<Id>,
-    /// γ (reads q̇ as `Var::Qd`).
-    pub gamma: Vec<Id>,
+    /// ν = −Φ_t, if the scene asked for velocities.
+    pub nu: Option<Vec<Id>>,
+    /// γ (reads q̇ as `Var::Qd`), if the scene asked for accelerations.
+    pub gamma: Option<Vec<Id>>,
     /// The initial guess q₀ (ground poses and declared guesses), in parameters.
     pub guess: Vec<Id>,
 }
@@ -39,7 +39,7 @@ pub struct Kinematics {
 impl Kinematics {
     /// The non-zero outputs of each generated kinematic function, by function name: what the
     /// emitter computes (zeros are cleared, not computed) and what operation counts cover.
-    pub fn function_outputs(&self, arena: &Arena) -> [(&'static str, Vec<Id>); 5] {
+    pub fn function_outputs(&self, arena: &Arena) -> Vec<(&'static str, Vec<Id>)> {
         let nonzero = |ids: &[Id]| -> Vec<Id> {
             ids.iter()
                 .copied()
@@ -53,9 +53,11 @@ impl Kinematics {
             ("phi", phi),
             ("jacobian", jacobian),
             ("phi_and_jacobian", both),
-            ("nu", nonzero(&self.nu)),
-            ("gamma", nonzero(&self.gamma)),
         ]
+        .into_iter()
+        .chain(self.nu.as_deref().map(|nu| ("nu", nonzero(nu))))
+        .chain(self.gamma.as_deref().map(|gamma| ("gamma", nonzero(gamma))))
+        .collect()
     }
 }
 
@@ -78,12 +80,35 @@ pub fn derive(model: &mut Model) -> Kinematics {
         }
     }
 
-    let phi_t: Vec<Id> = phi.iter().map(|&p| d.diff(arena, p, Var::T)).collect();
-    let nu = phi_t.iter().map(|&p| arena.neg(p)).collect();
+    // Time derivatives only for the outputs asked for: no work for what is left out.
+    let (mut nu, mut gamma) = (None, None);
+    if model.outputs >= Outputs::Velocities {
+        let phi_t: Vec<Id> = phi.iter().map(|&p| d.diff(arena, p, Var::T)).collect();
+        nu = Some(phi_t.iter().map(|&p| arena.neg(p)).collect());
+        if model.outputs >= Outputs::Accelerations {
+            gamma = Some(acceleration_rhs(arena, &mut d, &jacobian, &phi_t));
+        }
+    }
 
-    let mut gamma = Vec::with_capacity(phi.len());
+    let guess = model.bodies.iter().flat_map(|b| b.pose).collect();
+    Kinematics {
+        phi,
+        jacobian,
+        nu,
+        gamma,
+        guess,
+    }
+}
+
+/// γ_i = −(∂Φ̇_i/∂q · q̇ + ∂Φ̇_i/∂t) with Φ̇_i = Σ_k Φ_q[i,k] q̇_k + Φ_t,i.
+fn acceleration_rhs(
+    arena: &mut Arena,
+    d: &mut Differentiator,
+    jacobian: &[Entry],
+    phi_t: &[Id],
+) -> Vec<Id> {
+    let mut gamma = Vec::with_capacity(phi_t.len());
     for (row, &phi_t_i) in phi_t.iter().enumerate() {
-        // Φ̇_i = Σ_k Φ_q[i,k] q̇_k + Φ_t,i
         let mut phi_dot = phi_t_i;
         for e in jacobian.iter().filter(|e| e.row == row) {
             let qd = arena.var(Var::Qd(col_u32(e.col)));
@@ -101,15 +126,7 @@ pub fn derive(model: &mut Model) -> Kinematics {
         }
         gamma.push(arena.neg(total));
     }
-
-    let guess = model.bodies.iter().flat_map(|b| b.pose).collect();
-    Kinematics {
-        phi,
-        jacobian,
-        nu,
-        gamma,
-        guess,
-    }
+    gamma
 }
 
 fn col_u32(col: usize) -> u32 {
@@ -117,100 +134,122 @@ fn col_u32(col: usize) -> u32 {
 }
 
 /// Φ in equation order, from the model's constraints.
+///
+/// Ground bodies keep their coordinates and three ground equations (the system stays square
+/// and in Cartesian form), but every joint and driver sees a ground body through its constant
+/// pose: the solutions are the same, and ground bodies cost no trigonometry and no Jacobian
+/// entries outside their own rows.
 fn constraint_equations(model: &mut Model) -> Vec<Id> {
     let constraints: Vec<ConstraintKind> = model.constraints.iter().map(|c| c.kind).collect();
-    let a = &mut model.arena;
+    let poses: Vec<Option<[Id; 3]>> = model
+        .bodies
+        .iter()
+        .map(|b| b.ground.then_some(b.pose))
+        .collect();
+    let mut f = Frames {
+        arena: &mut model.arena,
+        poses: &poses,
+    };
     let mut phi = Vec::new();
     for kind in constraints {
         match kind {
             ConstraintKind::Ground { body, pose } => {
                 for (k, target) in pose.into_iter().enumerate() {
-                    let q = coord(a, body, k);
-                    phi.push(a.sub(q, target));
+                    let q = f.arena.var(Var::Q(col_u32(3 * body + k)));
+                    phi.push(f.arena.sub(q, target));
                 }
             }
-            ConstraintKind::Revolute { a: pa, b: pb } => {
-                let ra = world_point(a, pa);
-                let rb = world_point(a, pb);
-                phi.push(a.sub(ra[0], rb[0]));
-                phi.push(a.sub(ra[1], rb[1]));
+            ConstraintKind::Revolute { a, b } => {
+                let (ra, rb) = (f.world_point(a), f.world_point(b));
+                phi.push(f.arena.sub(ra[0], rb[0]));
+                phi.push(f.arena.sub(ra[1], rb[1]));
             }
-            ConstraintKind::Prismatic { a: pa, b: pb, axis } => {
+            ConstraintKind::Prismatic { a, b, axis } => {
                 // Normal n = A_a R u (R a quarter turn): b's point has no offset across the axis.
-                let neg_uy = a.neg(axis[1]);
-                let normal = rotate(a, pa.body, [neg_uy, axis[0]]);
-                let offset = separation(a, pa, pb);
-                phi.push(dot(a, normal, offset));
+                let neg_uy = f.arena.neg(axis[1]);
+                let normal = f.rotate(a.body, [neg_uy, axis[0]]);
+                let offset = f.separation(a, b);
+                phi.push(f.dot(normal, offset));
                 // No relative rotation, written linearly (θ_b − θ_a) rather than as the seed's
                 // sin(θ_b − θ_a): same solution set near the assembly, constant Jacobian entries,
                 // no trigonometry, and no spurious root at a half turn.
-                let (tb, ta) = (coord(a, pb.body, 2), coord(a, pa.body, 2));
-                phi.push(a.sub(tb, ta));
+                let (tb, ta) = (f.pose(b.body, 2), f.pose(a.body, 2));
+                phi.push(f.arena.sub(tb, ta));
             }
-            ConstraintKind::Distance {
-                a: pa,
-                b: pb,
-                length,
-            } => {
-                let d = separation(a, pa, pb);
-                let squared = dot(a, d, d);
-                let l2 = a.powi(length, 2);
-                phi.push(a.sub(squared, l2));
+            ConstraintKind::Distance { a, b, length } => {
+                let d = f.separation(a, b);
+                let squared = f.dot(d, d);
+                let l2 = f.arena.powi(length, 2);
+                phi.push(f.arena.sub(squared, l2));
             }
             ConstraintKind::Driver { driven, value } => {
-                let quantity = driven_quantity(a, driven);
-                phi.push(a.sub(quantity, value));
+                let quantity = f.driven_quantity(driven);
+                phi.push(f.arena.sub(quantity, value));
             }
         }
     }
     phi
 }
 
-fn driven_quantity(a: &mut Arena, driven: Driven) -> Id {
-    match driven {
-        Driven::Angle(body) => coord(a, body, 2),
-        Driven::RelativeAngle(from, to) => {
-            let (tt, tf) = (coord(a, to, 2), coord(a, from, 2));
-            a.sub(tt, tf)
-        }
-        Driven::X(p) => world_point(a, p)[0],
-        Driven::Y(p) => world_point(a, p)[1],
-        Driven::Travel { a: pa, b: pb, axis } => {
-            let u = rotate(a, pa.body, axis);
-            let d = separation(a, pa, pb);
-            dot(a, u, d)
+/// Body frames as joints see them: a moving body through its coordinates, a ground body
+/// through its constant pose.
+struct Frames<'a> {
+    arena: &'a mut Arena,
+    /// The pose of each ground body; `None` for moving bodies.
+    poses: &'a [Option<[Id; 3]>],
+}
+
+impl Frames<'_> {
+    /// Coordinate `k` (0 x, 1 y, 2 θ) of `body`: q for a moving body, the pose for a ground one.
+    fn pose(&mut self, body: usize, k: usize) -> Id {
+        match self.poses.get(body).copied().flatten() {
+            Some(pose) => pose[k],
+            None => self.arena.var(Var::Q(col_u32(3 * body + k))),
         }
     }
-}
 
-/// q index of coordinate `k` (0 x, 1 y, 2 θ) of `body`.
-fn coord(a: &mut Arena, body: usize, k: usize) -> Id {
-    a.var(Var::Q(col_u32(3 * body + k)))
-}
+    /// A(θ_body) v
+    fn rotate(&mut self, body: usize, v: [Id; 2]) -> [Id; 2] {
+        let theta = self.pose(body, 2);
+        let a = &mut *self.arena;
+        let (c, s) = (a.cos(theta), a.sin(theta));
+        let (cx, sy) = (a.mul(c, v[0]), a.mul(s, v[1]));
+        let (sx, cy) = (a.mul(s, v[0]), a.mul(c, v[1]));
+        [a.sub(cx, sy), a.add(sx, cy)]
+    }
 
-/// A(θ_body) v
-fn rotate(a: &mut Arena, body: usize, v: [Id; 2]) -> [Id; 2] {
-    let theta = coord(a, body, 2);
-    let (c, s) = (a.cos(theta), a.sin(theta));
-    let (cx, sy) = (a.mul(c, v[0]), a.mul(s, v[1]));
-    let (sx, cy) = (a.mul(s, v[0]), a.mul(c, v[1]));
-    [a.sub(cx, sy), a.add(sx, cy)]
-}
+    /// r_body + A(θ_body) s
+    fn world_point(&mut self, p: Point) -> [Id; 2] {
+        let offset = self.rotate(p.body, p.local);
+        let (x, y) = (self.pose(p.body, 0), self.pose(p.body, 1));
+        [self.arena.add(x, offset[0]), self.arena.add(y, offset[1])]
+    }
 
-/// r_body + A(θ_body) s
-fn world_point(a: &mut Arena, p: Point) -> [Id; 2] {
-    let offset = rotate(a, p.body, p.local);
-    let (x, y) = (coord(a, p.body, 0), coord(a, p.body, 1));
-    [a.add(x, offset[0]), a.add(y, offset[1])]
-}
+    /// World vector from `from`'s point to `to`'s point.
+    fn separation(&mut self, from: Point, to: Point) -> [Id; 2] {
+        let (rf, rt) = (self.world_point(from), self.world_point(to));
+        [self.arena.sub(rt[0], rf[0]), self.arena.sub(rt[1], rf[1])]
+    }
 
-/// World vector from `from`'s point to `to`'s point.
-fn separation(a: &mut Arena, from: Point, to: Point) -> [Id; 2] {
-    let (rf, rt) = (world_point(a, from), world_point(a, to));
-    [a.sub(rt[0], rf[0]), a.sub(rt[1], rf[1])]
-}
+    fn dot(&mut self, u: [Id; 2], v: [Id; 2]) -> Id {
+        let (x, y) = (self.arena.mul(u[0], v[0]), self.arena.mul(u[1], v[1]));
+        self.arena.add(x, y)
+    }
 
-fn dot(a: &mut Arena, u: [Id; 2], v: [Id; 2]) -> Id {
-    let (x, y) = (a.mul(u[0], v[0]), a.mul(u[1], v[1]));
-    a.add(x, y)
+    fn driven_quantity(&mut self, driven: Driven) -> Id {
+        match driven {
+            Driven::Angle(body) => self.pose(body, 2),
+            Driven::RelativeAngle(from, to) => {
+                let (tt, tf) = (self.pose(to, 2), self.pose(from, 2));
+                self.arena.sub(tt, tf)
+            }
+            Driven::X(p) => self.world_point(p)[0],
+            Driven::Y(p) => self.world_point(p)[1],
+            Driven::Travel { a, b, axis } => {
+                let u = self.rotate(a.body, axis);
+                let d = self.separation(a, b);
+                self.dot(u, d)
+            }
+        }
+    }
 }

@@ -24,6 +24,31 @@ pub struct Model {
     pub bodies: Vec<Body>,
     /// Constraints in equation order: ground bodies, then joints, then drivers.
     pub constraints: Vec<Constraint>,
+    /// What the scene asked to compute.
+    pub outputs: Outputs,
+}
+
+/// Which kinematic outputs a scene computes (the spec's `outputs` line; default all three).
+/// Ordered: each level includes the ones before it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Outputs {
+    /// Positions only.
+    Positions,
+    /// Positions and velocities.
+    Velocities,
+    /// Positions, velocities and accelerations.
+    Accelerations,
+}
+
+impl Outputs {
+    /// Every level, in order; `ALL[k]` is named `NAMES[k]` in specs.
+    pub const ALL: [Outputs; 3] = [
+        Outputs::Positions,
+        Outputs::Velocities,
+        Outputs::Accelerations,
+    ];
+    /// The names used in the `outputs` statement.
+    pub const NAMES: [&'static str; 3] = ["positions", "velocities", "accelerations"];
 }
 
 /// A run-time parameter.

@@ -12,7 +12,9 @@
 //!     joint slide: prismatic(liner, piston, along (1, 0));
 //!     joint link: distance(a @ (0, 10), b, 120);
 //!     driver crank: angle(crank) = omega * t;   also relative_angle(a, b), x(point),
-//! }                                              y(point), travel(prismatic_joint)
+//!                                                y(point), travel(prismatic_joint)
+//!     outputs positions, velocities;            optional; default: all three
+//! }
 //! ```
 //!
 //! A point is `body @ (x, y)` in the body's frame, or `body` alone for its reference point.
@@ -38,6 +40,7 @@ mod kw {
     syn::custom_keyword!(at);
     syn::custom_keyword!(near);
     syn::custom_keyword!(along);
+    syn::custom_keyword!(outputs);
 }
 
 /// Parses a `mechanism` declaration from tokens (the macro's input).
@@ -79,6 +82,7 @@ impl Parse for Spec {
             bodies: Vec::new(),
             joints: Vec::new(),
             drivers: Vec::new(),
+            outputs: None,
         };
         while !content.is_empty() {
             statement(&content, &mut spec)?;
@@ -157,6 +161,17 @@ fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> {
             kind_span,
             kind,
         });
+    } else if look.peek(kw::outputs) {
+        let keyword = input.parse::<kw::outputs>()?;
+        if !docs.is_empty() || spec.outputs.is_some() {
+            return Err(syn::Error::new(
+                keyword.span,
+                "a scene has at most one `outputs` statement, without doc comments",
+            ));
+        }
+        let names =
+            syn::punctuated::Punctuated::<Ident, Token![,]>::parse_separated_nonempty(input)?;
+        spec.outputs = Some(names.into_iter().collect());
     } else if look.peek(kw::driver) {
         input.parse::<kw::driver>()?;
         let name = input.parse()?;

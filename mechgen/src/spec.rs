@@ -22,6 +22,8 @@ pub struct Spec {
     pub joints: Vec<JointDecl>,
     /// Drivers in declaration order.
     pub drivers: Vec<DriverDecl>,
+    /// The `outputs …;` statement, if any: the listed names with their spans.
+    pub outputs: Option<Vec<proc_macro2::Ident>>,
 }
 
 /// `param omega = 314.0;`

@@ -30,10 +30,12 @@ mod state;
 
 pub use error::{Described, Quantity, SolveError};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
-pub use mechanism::{Matrix, Mechanism, ParameterError, Storage, Vector};
+pub use mechanism::{
+    Accelerations, Matrix, Mechanism, Outputs, ParameterError, Storage, Vector, Velocities,
+};
 pub use simulate::{Simulation, sample_time};
-pub use solver::{Convergence, Solver, SolverOptions};
-pub use state::{BodyState, State, write_csv_header};
+pub use solver::{Convergence, Solver, SolverOptions, solve_accelerations, solve_velocities};
+pub use state::{BodyState, Pose, PoseVelocity, State, write_csv_header};
 
 /// Re-exported so generated code and users name one crate.
 pub use nalgebra;

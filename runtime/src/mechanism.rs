@@ -3,6 +3,9 @@
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector};
 
+use crate::error::SolveError;
+use crate::lu::Lu;
+
 /// A column of coordinates or equation values (`Const<N>` for generated scenes: on the stack).
 pub type Vector<D> = OVector<f64, D>;
 /// A square matrix over coordinates × equations, such as the Jacobian Φ_q.
@@ -35,11 +38,28 @@ impl core::fmt::Display for ParameterError {
 
 impl core::error::Error for ParameterError {}
 
+/// Which kinematic outputs a scene computes: the spec's `outputs` line (default: all three).
+///
+/// Ordered: each level includes the ones before it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Outputs {
+    /// Positions q only.
+    Positions,
+    /// Positions and velocities q̇.
+    Velocities,
+    /// Positions, velocities and accelerations q̈.
+    Accelerations,
+}
+
 /// The kinematic equations of a planar mechanism in Cartesian body coordinates.
 ///
 /// `q` holds `(x, y, θ)` for every body in declaration order; equations follow the scene's
 /// declaration order (ground bodies, joints, drivers). The system is square: `dim()` coordinates and
 /// `dim()` equations. Implementations are straight-line code: they must not allocate or panic.
+///
+/// This trait covers positions. A scene that asked for velocities also implements [`Velocities`]
+/// (ν), and one that asked for accelerations [`Accelerations`] (γ), so asking for an output a
+/// scene left out is a compile error, not a run-time one.
 pub trait Mechanism
 where
     DefaultAllocator: Storage<Self::Dim>,
@@ -93,9 +113,40 @@ where
         self.jacobian(q, t, jacobian);
     }
 
+    /// The outputs this scene computes.
+    fn outputs(&self) -> Outputs;
+
+    /// Solves the time derivatives this scene provides at converged positions `q`, where
+    /// `factors` holds the LU of Φ_q(q): generated code calls [`crate::solve_velocities`] and
+    /// [`crate::solve_accelerations`] for the outputs it declares; a positions-only scene does
+    /// nothing. The solver calls this; users call [`crate::Solver::solve_into`].
+    ///
+    /// # Errors
+    /// Those of the derivative solves ([`SolveError::NonFinite`] for ν, γ, q̇ or q̈).
+    fn derivatives(
+        &self,
+        q: &Vector<Self::Dim>,
+        t: f64,
+        factors: &Lu<Self::Dim>,
+        qd: &mut Vector<Self::Dim>,
+        qdd: &mut Vector<Self::Dim>,
+    ) -> Result<(), SolveError>;
+}
+
+/// A scene that computes velocities: Φ_q q̇ = ν.
+pub trait Velocities: Mechanism
+where
+    DefaultAllocator: Storage<Self::Dim>,
+{
     /// Writes the velocity right-hand side ν = −Φ_t, so that Φ_q q̇ = ν.
     fn nu(&self, q: &Vector<Self::Dim>, t: f64, out: &mut Vector<Self::Dim>);
+}
 
+/// A scene that computes accelerations: Φ_q q̈ = γ.
+pub trait Accelerations: Velocities
+where
+    DefaultAllocator: Storage<Self::Dim>,
+{
     /// Writes the acceleration right-hand side γ = −(Φ_q q̇)_q q̇ − 2 Φ_qt q̇ − Φ_tt, so that Φ_q q̈ = γ.
     fn gamma(
         &self,

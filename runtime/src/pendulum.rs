@@ -6,8 +6,13 @@
 
 use nalgebra::Const;
 
+use crate::error::SolveError;
+use crate::lu::Lu;
 use crate::math::{cos, sin};
-use crate::mechanism::{Matrix, Mechanism, ParameterError, Vector};
+use crate::mechanism::{
+    Accelerations, Matrix, Mechanism, Outputs, ParameterError, Vector, Velocities,
+};
+use crate::solver::{solve_accelerations, solve_velocities};
 
 #[derive(Debug, Clone)]
 pub struct Pendulum {
@@ -93,9 +98,37 @@ impl Mechanism for Pendulum {
             third[0], third[1], third[2],
         ]);
     }
+
+    fn outputs(&self) -> Outputs {
+        Outputs::Accelerations
+    }
+
+    fn derivatives(
+        &self,
+
+        q: &Vector<Self::Dim>,
+
+        t: f64,
+
+        factors: &Lu<Self::Dim>,
+
+        qd: &mut Vector<Self::Dim>,
+
+        qdd: &mut Vector<Self::Dim>,
+    ) -> Result<(), SolveError> {
+        solve_velocities(self, q, t, factors, qd)?;
+
+        solve_accelerations(self, q, qd, t, factors, qdd)
+    }
+}
+
+impl Velocities for Pendulum {
     fn nu(&self, _: &Vector<Const<3>>, _: f64, out: &mut Vector<Const<3>>) {
         *out = Vector::from([0.0, 0.0, self.omega]);
     }
+}
+
+impl Accelerations for Pendulum {
     fn gamma(
         &self,
         q: &Vector<Const<3>>,
@@ -115,7 +148,10 @@ pub struct DynPendulum(pub Pendulum);
 
 #[cfg(feature = "alloc")]
 mod dynamic {
-    use super::{DynPendulum, Mechanism, ParameterError, Vector};
+    use super::{
+        Accelerations, DynPendulum, Lu, Mechanism, Outputs, ParameterError, SolveError, Vector,
+        Velocities, solve_accelerations, solve_velocities,
+    };
     use crate::mechanism::Matrix;
     use nalgebra::{Const, Dyn, Matrix3, Vector3};
 
@@ -162,11 +198,39 @@ mod dynamic {
             self.0.jacobian(&fixed(q), t, &mut jacobian);
             out.copy_from(&jacobian);
         }
+
+        fn outputs(&self) -> Outputs {
+            Outputs::Accelerations
+        }
+
+        fn derivatives(
+            &self,
+
+            q: &Vector<Self::Dim>,
+
+            t: f64,
+
+            factors: &Lu<Self::Dim>,
+
+            qd: &mut Vector<Self::Dim>,
+
+            qdd: &mut Vector<Self::Dim>,
+        ) -> Result<(), SolveError> {
+            solve_velocities(self, q, t, factors, qd)?;
+
+            solve_accelerations(self, q, qd, t, factors, qdd)
+        }
+    }
+
+    impl Velocities for DynPendulum {
         fn nu(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
             let mut nu = Vector3::zeros();
             self.0.nu(&fixed(q), t, &mut nu);
             out.copy_from_slice(nu.as_slice());
         }
+    }
+
+    impl Accelerations for DynPendulum {
         fn gamma(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
             let mut gamma = Vector3::zeros();
             self.0.gamma(&fixed(q), &fixed(qd), t, &mut gamma);

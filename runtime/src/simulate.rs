@@ -3,7 +3,7 @@
 use nalgebra::DefaultAllocator;
 
 use crate::error::SolveError;
-use crate::mechanism::{Mechanism, Storage};
+use crate::mechanism::{Mechanism, Outputs, Storage};
 use crate::solver::Solver;
 use crate::state::State;
 
@@ -17,7 +17,10 @@ where
 {
     solver: Solver<M>,
     current: State<M>,
+    /// Scratch for the next solve; after a step it holds the state before `current`.
     next: State<M>,
+    /// Whether `next` holds a solved earlier state (for the positions-only predictor).
+    has_previous: bool,
     predictor: bool,
 }
 
@@ -30,14 +33,14 @@ where
     /// # Errors
     /// The [`SolveError`] of the first solve (the solver is dropped with it).
     pub fn new(mut solver: Solver<M>, t0: f64) -> Result<Self, SolveError> {
-        let dim = solver.mechanism().dim();
-        let mut current = State::zeros(dim);
+        let mut current = State::new(solver.mechanism());
         solver.mechanism().initial_guess(&mut current.q);
         solver.solve_into(t0, &mut current)?;
         Ok(Self {
             next: current.clone(),
             solver,
             current,
+            has_previous: false,
             predictor: true,
         })
     }
@@ -72,8 +75,10 @@ where
         self.solver
     }
 
-    /// Solves at `t`, starting Newton from `q + q̇ h + ½ q̈ h²` (`h = t − t_last`) when the
-    /// predictor is on; that guess is O(h³) off, so Newton typically needs one or two updates.
+    /// Solves at `t`, starting Newton from a prediction when the predictor is on: the Taylor
+    /// expansion `q + q̇ h + ½ q̈ h²` (`h = t − t_last`) with the derivatives the scene computes,
+    /// or, for a positions-only scene, the secant through the last two solved positions. The
+    /// second-order guess is O(h³) off, so Newton typically needs one or two updates.
     ///
     /// # Errors
     /// The [`SolveError`] of the solve at `t`; the simulation stays at the previous state.
@@ -83,18 +88,26 @@ where
         let predict = self.predictor && h.is_finite();
         let (q, qd, qdd) = (
             current.q.as_slice(),
-            current.qd.as_slice(),
-            current.qdd.as_slice(),
+            current.velocities.as_slice(),
+            current.accelerations.as_slice(),
         );
+        // Secant slope (q − q_prev)/h_prev for positions-only scenes, from the previous state
+        // still held in `next`.
+        let h_prev = current.t - next.t;
+        let secant = self.has_previous && h_prev != 0.0 && h_prev.is_finite();
+        let outputs = current.outputs();
         for (k, guess) in next.q.as_mut_slice().iter_mut().enumerate() {
-            *guess = if predict {
-                q[k] + h * qd[k] + 0.5 * h * h * qdd[k]
-            } else {
-                q[k]
+            *guess = match outputs {
+                _ if !predict => q[k],
+                Outputs::Accelerations => q[k] + h * qd[k] + 0.5 * h * h * qdd[k],
+                Outputs::Velocities => q[k] + h * qd[k],
+                Outputs::Positions if secant => q[k] + (q[k] - *guess) * (h / h_prev),
+                Outputs::Positions => q[k],
             };
         }
         self.solver.solve_into(t, next)?;
         core::mem::swap(&mut self.current, &mut self.next);
+        self.has_previous = true;
         Ok(&self.current)
     }
 
@@ -157,7 +170,7 @@ mod tests {
             .run(2.0, 40, |state| {
                 let exact = Pendulum::default().exact(state.t);
                 assert!((state.q.x - exact[0][0]).abs() < 1e-12);
-                assert!((state.qdd.y - exact[2][1]).abs() < 1e-12);
+                assert!((state.accelerations.y - exact[2][1]).abs() < 1e-12);
                 (total, calls, last_t) = (total + state.iterations, calls + 1, state.t);
             })
             .unwrap();

@@ -4,7 +4,7 @@ use nalgebra::{DefaultAllocator, Dim, U1};
 
 use crate::error::{Quantity, SolveError};
 use crate::lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
-use crate::mechanism::{Mechanism, Storage, Vector};
+use crate::mechanism::{Accelerations, Mechanism, Outputs, Storage, Vector, Velocities};
 use crate::state::State;
 
 /// Tolerances of the position solve and the factorisation.
@@ -174,44 +174,20 @@ where
                 && step <= options.step_tolerance * scale;
             *q -= &*phi;
             iterations += 1;
+            // A positions-only scene needs no factors at the returned q (nothing solves with
+            // them): stop without the confirming evaluation; `residual` is then the one before
+            // the last (tiny) step, an upper bound.
+            if converged && mechanism.outputs() == Outputs::Positions {
+                return Ok(Convergence {
+                    iterations,
+                    residual,
+                    condition: lu.rough_condition().unwrap_or(f64::INFINITY),
+                });
+            }
         }
     }
 
-    /// Solves Φ_q q̇ = ν at positions `q` (assumed to satisfy Φ = 0) into `qd`.
-    ///
-    /// # Errors
-    /// [`SolveError::NonFinite`] or [`SolveError::Singular`] as for positions.
-    pub fn solve_velocity(
-        &mut self,
-        q: &Vector<M::Dim>,
-        t: f64,
-        qd: &mut Vector<M::Dim>,
-    ) -> Result<(), SolveError> {
-        self.check_inputs(t, q, Quantity::Guess)?;
-        self.check_len(qd)?;
-        self.factor_jacobian(q, t)?;
-        self.velocity_from_factors(q, t, qd)
-    }
-
-    /// Solves Φ_q q̈ = γ(q, q̇, t) into `qdd`.
-    ///
-    /// # Errors
-    /// [`SolveError::NonFinite`] or [`SolveError::Singular`] as for positions.
-    pub fn solve_acceleration(
-        &mut self,
-        q: &Vector<M::Dim>,
-        qd: &Vector<M::Dim>,
-        t: f64,
-        qdd: &mut Vector<M::Dim>,
-    ) -> Result<(), SolveError> {
-        self.check_inputs(t, q, Quantity::Guess)?;
-        self.check_inputs(t, qd, Quantity::Velocity)?;
-        self.check_len(qdd)?;
-        self.factor_jacobian(q, t)?;
-        self.acceleration_from_factors(q, qd, t, qdd)
-    }
-
-    /// Positions (from `q_guess`), velocities and accelerations at `t`.
+    /// Positions (from `q_guess`) at `t`, and the derivatives the scene provides.
     ///
     /// Allocates the returned state for `Dyn` mechanisms; use [`Solver::solve_into`] to reuse one.
     ///
@@ -219,13 +195,14 @@ where
     /// As [`Solver::solve_into`].
     pub fn solve(&mut self, t: f64, q_guess: &Vector<M::Dim>) -> Result<State<M>, SolveError> {
         self.check_len(q_guess)?;
-        let mut state = State::<M>::zeros(self.mechanism.dim());
+        let mut state = State::new(&self.mechanism);
         state.q.copy_from(q_guess);
         self.solve_into(t, &mut state)?;
         Ok(state)
     }
 
-    /// Solves positions starting from `state.q`, then velocities and accelerations, into `state`.
+    /// Solves positions starting from `state.q`, then the derivatives the scene provides
+    /// ([`Mechanism::derivatives`]), into `state`.
     ///
     /// Φ_q is factored once for both ν and γ solves: [`Solver::solve_position`] ends by
     /// evaluating and factoring Φ_q at the positions it returns, and those factors are reused.
@@ -234,11 +211,16 @@ where
     /// # Errors
     /// Any [`SolveError`] of the position, velocity or acceleration solve.
     pub fn solve_into(&mut self, t: f64, state: &mut State<M>) -> Result<(), SolveError> {
-        self.check_len(&state.qd)?;
-        self.check_len(&state.qdd)?;
+        self.check_len(&state.velocities)?;
+        self.check_len(&state.accelerations)?;
         let convergence = self.solve_position(&mut state.q, t)?;
-        self.velocity_from_factors(&state.q, t, &mut state.qd)?;
-        self.acceleration_from_factors(&state.q, &state.qd, t, &mut state.qdd)?;
+        self.mechanism.derivatives(
+            &state.q,
+            t,
+            &self.lu,
+            &mut state.velocities,
+            &mut state.accelerations,
+        )?;
         state.t = t;
         state.iterations = convergence.iterations;
         Ok(())
@@ -249,31 +231,6 @@ where
         self.lu
             .factor_with(|jacobian| mechanism.jacobian(q, t, jacobian))
             .map_err(|error| lu_error(error, t))
-    }
-
-    fn velocity_from_factors(
-        &self,
-        q: &Vector<M::Dim>,
-        t: f64,
-        qd: &mut Vector<M::Dim>,
-    ) -> Result<(), SolveError> {
-        self.mechanism.nu(q, t, qd);
-        check_finite(qd, t, Quantity::Nu)?;
-        self.lu.solve_in_place(qd).map_err(|e| lu_error(e, t))?;
-        check_finite(qd, t, Quantity::Velocity)
-    }
-
-    fn acceleration_from_factors(
-        &self,
-        q: &Vector<M::Dim>,
-        qd: &Vector<M::Dim>,
-        t: f64,
-        qdd: &mut Vector<M::Dim>,
-    ) -> Result<(), SolveError> {
-        self.mechanism.gamma(q, qd, t, qdd);
-        check_finite(qdd, t, Quantity::Gamma)?;
-        self.lu.solve_in_place(qdd).map_err(|e| lu_error(e, t))?;
-        check_finite(qdd, t, Quantity::Acceleration)
     }
 
     /// Length and finiteness of an input, and finiteness of `t`.
@@ -302,6 +259,93 @@ where
             })
         }
     }
+}
+
+impl<M: Velocities> Solver<M>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    /// Solves Φ_q q̇ = ν at positions `q` (assumed to satisfy Φ = 0) into `qd`.
+    ///
+    /// # Errors
+    /// [`SolveError::NonFinite`] or [`SolveError::Singular`] as for positions.
+    pub fn solve_velocity(
+        &mut self,
+        q: &Vector<M::Dim>,
+        t: f64,
+        qd: &mut Vector<M::Dim>,
+    ) -> Result<(), SolveError> {
+        self.check_inputs(t, q, Quantity::Guess)?;
+        self.check_len(qd)?;
+        self.factor_jacobian(q, t)?;
+        solve_velocities(&self.mechanism, q, t, &self.lu, qd)
+    }
+}
+
+impl<M: Accelerations> Solver<M>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    /// Solves Φ_q q̈ = γ(q, q̇, t) into `qdd`.
+    ///
+    /// # Errors
+    /// [`SolveError::NonFinite`] or [`SolveError::Singular`] as for positions.
+    pub fn solve_acceleration(
+        &mut self,
+        q: &Vector<M::Dim>,
+        qd: &Vector<M::Dim>,
+        t: f64,
+        qdd: &mut Vector<M::Dim>,
+    ) -> Result<(), SolveError> {
+        self.check_inputs(t, q, Quantity::Guess)?;
+        self.check_inputs(t, qd, Quantity::Velocity)?;
+        self.check_len(qdd)?;
+        self.factor_jacobian(q, t)?;
+        solve_accelerations(&self.mechanism, q, qd, t, &self.lu, qdd)
+    }
+}
+
+/// Solves Φ_q q̇ = ν into `qd` with `factors`, the LU of Φ_q(q): the velocity half of
+/// [`Mechanism::derivatives`] for scenes that compute velocities.
+///
+/// # Errors
+/// [`SolveError::NonFinite`] for a non-finite ν or q̇; the factorisation's errors.
+pub fn solve_velocities<M: Velocities>(
+    mechanism: &M,
+    q: &Vector<M::Dim>,
+    t: f64,
+    factors: &Lu<M::Dim>,
+    qd: &mut Vector<M::Dim>,
+) -> Result<(), SolveError>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    mechanism.nu(q, t, qd);
+    check_finite(qd, t, Quantity::Nu)?;
+    factors.solve_in_place(qd).map_err(|e| lu_error(e, t))?;
+    check_finite(qd, t, Quantity::Velocity)
+}
+
+/// Solves Φ_q q̈ = γ(q, q̇, t) into `qdd` with `factors`, the LU of Φ_q(q): the acceleration
+/// half of [`Mechanism::derivatives`].
+///
+/// # Errors
+/// [`SolveError::NonFinite`] for a non-finite γ or q̈; the factorisation's errors.
+pub fn solve_accelerations<M: Accelerations>(
+    mechanism: &M,
+    q: &Vector<M::Dim>,
+    qd: &Vector<M::Dim>,
+    t: f64,
+    factors: &Lu<M::Dim>,
+    qdd: &mut Vector<M::Dim>,
+) -> Result<(), SolveError>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    mechanism.gamma(q, qd, t, qdd);
+    check_finite(qdd, t, Quantity::Gamma)?;
+    factors.solve_in_place(qdd).map_err(|e| lu_error(e, t))?;
+    check_finite(qdd, t, Quantity::Acceleration)
 }
 
 /// ‖v‖∞ over the contiguous storage (nalgebra's `amax` iterates element by element, slowly).
@@ -351,7 +395,10 @@ mod tests {
 
     fn assert_exact(state: &State<Pendulum>, mechanism: &Pendulum) {
         let exact = mechanism.exact(state.t);
-        for (computed, expected) in [&state.q, &state.qd, &state.qdd].into_iter().zip(exact) {
+        for (computed, expected) in [&state.q, &state.velocities, &state.accelerations]
+            .into_iter()
+            .zip(exact)
+        {
             for (c, e) in computed.iter().zip(expected) {
                 assert!((c - e).abs() <= 1e-12 * e.abs().max(1.0), "{c} vs {e}");
             }
@@ -382,8 +429,8 @@ mod tests {
         let mut qdd = qd;
         solver.solve_velocity(&q, 2.0, &mut qd).unwrap();
         solver.solve_acceleration(&q, &qd, 2.0, &mut qdd).unwrap();
-        let mut state = State::zeros(nalgebra::Const);
-        (state.t, state.q, state.qd, state.qdd) = (2.0, q, qd, qdd);
+        let mut state = State::new(solver.mechanism());
+        (state.t, state.q, state.velocities, state.accelerations) = (2.0, q, qd, qdd);
         assert_exact(&state, solver.mechanism());
     }
 
@@ -456,7 +503,7 @@ mod tests {
             .solve(0.7, &DVector::from_row_slice(&[2.0, 0.1, 0.1]))
             .unwrap();
         let exact = Pendulum::default().exact(0.7);
-        assert!((state.qdd[1] - exact[2][1]).abs() < 1e-12);
+        assert!((state.accelerations[1] - exact[2][1]).abs() < 1e-12);
 
         let mismatch = SolveError::DimensionMismatch {
             expected: 3,
@@ -464,7 +511,7 @@ mod tests {
         };
         assert_eq!(solver.solve(0.7, &DVector::zeros(2)).err(), Some(mismatch));
         let mut short = state.clone();
-        short.qdd = DVector::zeros(2);
+        short.accelerations = DVector::zeros(2);
         assert_eq!(solver.solve_into(0.7, &mut short), Err(mismatch));
         let mut long = DVector::zeros(4);
         assert!(solver.solve_position(&mut long, 0.7).is_err());

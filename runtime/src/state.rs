@@ -5,12 +5,14 @@ use core::marker::PhantomData;
 
 use nalgebra::{DefaultAllocator, Dim};
 
-use crate::mechanism::{Mechanism, Storage, Vector};
+use crate::mechanism::{Accelerations, Mechanism, Outputs, Storage, Vector, Velocities};
 
-/// Positions, velocities and accelerations of a mechanism at time `t`.
+/// Positions (and the derivatives the scene provides) of a mechanism at time `t`.
 ///
 /// Typed by the mechanism (not just its dimension) so generated code can add named accessors
-/// such as `state.piston()` for its own scene only.
+/// such as `state.piston()` for its own scene only, and so that [`State::qd`] and
+/// [`State::qdd`] exist only for scenes that compute velocities and accelerations: reading an
+/// output the scene left out is a compile error.
 pub struct State<M: Mechanism>
 where
     DefaultAllocator: Storage<M::Dim>,
@@ -19,14 +21,44 @@ where
     pub t: f64,
     /// Positions q.
     pub q: Vector<M::Dim>,
-    /// Velocities q̇.
-    pub qd: Vector<M::Dim>,
-    /// Accelerations q̈.
-    pub qdd: Vector<M::Dim>,
+    /// Velocities q̇ (zero unless the scene computes them).
+    pub(crate) velocities: Vector<M::Dim>,
+    /// Accelerations q̈ (zero unless the scene computes them).
+    pub(crate) accelerations: Vector<M::Dim>,
     /// Newton updates the position solve needed.
     pub iterations: usize,
+    /// What the scene computes, which decides the CSV columns.
+    outputs: Outputs,
     // `fn() -> M` keeps `State` Send/Sync/Clone regardless of `M`.
     mechanism: PhantomData<fn() -> M>,
+}
+
+/// One body's pose.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pose {
+    /// Reference point x.
+    pub x: f64,
+    /// Reference point y.
+    pub y: f64,
+    /// Orientation θ (radians).
+    pub theta: f64,
+}
+
+/// One body's pose and velocity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PoseVelocity {
+    /// Reference point x.
+    pub x: f64,
+    /// Reference point y.
+    pub y: f64,
+    /// Orientation θ (radians).
+    pub theta: f64,
+    /// ẋ.
+    pub x_dot: f64,
+    /// ẏ.
+    pub y_dot: f64,
+    /// θ̇.
+    pub theta_dot: f64,
 }
 
 /// One body's pose and its first two time derivatives.
@@ -52,61 +84,130 @@ pub struct BodyState {
     pub theta_ddot: f64,
 }
 
+/// Coordinates `3·index .. 3·index + 2` of `v`; `None` past the end.
+fn read3<D: Dim>(v: &Vector<D>, index: usize) -> Option<[f64; 3]>
+where
+    DefaultAllocator: Storage<D>,
+{
+    let first = index.checked_mul(3)?;
+    let slice = v.as_slice().get(first..first.checked_add(3)?)?;
+    Some([slice[0], slice[1], slice[2]])
+}
+
 impl<M: Mechanism> State<M>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
-    /// An all-zero state at `t = 0` (allocates for `Dyn`, lives on the stack for `Const`).
-    pub fn zeros(dim: M::Dim) -> Self {
+    /// An all-zero state at `t = 0` for `mechanism` (allocates for `Dyn`, lives on the stack
+    /// for `Const`).
+    pub fn new(mechanism: &M) -> Self {
+        let dim = mechanism.dim();
         Self {
             t: 0.0,
             q: Vector::zeros_generic(dim, nalgebra::U1),
-            qd: Vector::zeros_generic(dim, nalgebra::U1),
-            qdd: Vector::zeros_generic(dim, nalgebra::U1),
+            velocities: Vector::zeros_generic(dim, nalgebra::U1),
+            accelerations: Vector::zeros_generic(dim, nalgebra::U1),
             iterations: 0,
+            outputs: mechanism.outputs(),
             mechanism: PhantomData,
         }
     }
 
-    /// Body `index` (declaration order), read from coordinates `3·index .. 3·index + 2`;
-    /// `None` past the end.
-    pub fn body(&self, index: usize) -> Option<BodyState> {
-        let first = index.checked_mul(3)?;
-        let at = |v: &Vector<M::Dim>, offset: usize| v.get(first.checked_add(offset)?).copied();
-        Some(BodyState {
-            x: at(&self.q, 0)?,
-            y: at(&self.q, 1)?,
-            theta: at(&self.q, 2)?,
-            x_dot: at(&self.qd, 0)?,
-            y_dot: at(&self.qd, 1)?,
-            theta_dot: at(&self.qd, 2)?,
-            x_ddot: at(&self.qdd, 0)?,
-            y_ddot: at(&self.qdd, 1)?,
-            theta_ddot: at(&self.qdd, 2)?,
-        })
+    /// The outputs this state holds (its scene's).
+    pub fn outputs(&self) -> Outputs {
+        self.outputs
     }
 
-    /// Writes `t, q…, q̇…, q̈…` as one CSV line ending in `\n`, matching [`write_csv_header`].
+    /// Pose of body `index` (declaration order); `None` past the end.
+    pub fn pose(&self, index: usize) -> Option<Pose> {
+        let [x, y, theta] = read3(&self.q, index)?;
+        Some(Pose { x, y, theta })
+    }
+
+    /// Writes `t`, then q (and q̇, q̈ when the scene computes them) as one CSV line ending in
+    /// `\n`, matching [`write_csv_header`].
     ///
-    /// Numbers use `f64`'s `Display`: the shortest string that parses back to the same value,
-    /// never in exponent form. A NaN or infinity (which a successful solve never produces) is
-    /// written as `NaN`/`inf`/`-inf`, which Rust's and most CSV readers' float parsers accept.
+    /// Numbers are the shortest strings that parse back to the same value, with an exponent
+    /// for tiny and huge magnitudes (`5.2e-30`). A NaN or infinity (which a successful solve
+    /// never produces) is written as `NaN`/`inf`/`-inf`, which float parsers accept.
     ///
     /// # Errors
     /// Whatever `out` returns.
     pub fn write_csv_row<W: Write>(&self, out: &mut W) -> fmt::Result {
-        // `{:?}` is the shortest round-trip form, with an exponent for tiny and huge values
-        // (`5.2e-30`, not thirty zeros).
         write!(out, "{:?}", self.t)?;
-        for value in self.q.iter().chain(&self.qd).chain(&self.qdd) {
-            write!(out, ",{value:?}")?;
+        let columns = [&self.q, &self.velocities, &self.accelerations];
+        for column in columns.iter().take(column_groups(self.outputs)) {
+            for value in column.as_slice() {
+                write!(out, ",{value:?}")?;
+            }
         }
         out.write_char('\n')
     }
 }
 
-/// Writes the CSV header line: `t`, every coordinate name, then the names with `_dot`, then
-/// with `_ddot` (`t,piston.x,…,piston.x_dot,…,piston.x_ddot,…\n`).
+impl<M: Velocities> State<M>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    /// Velocities q̇.
+    pub fn qd(&self) -> &Vector<M::Dim> {
+        &self.velocities
+    }
+
+    /// Pose and velocity of body `index`; `None` past the end.
+    pub fn pose_velocity(&self, index: usize) -> Option<PoseVelocity> {
+        let [x, y, theta] = read3(&self.q, index)?;
+        let [x_dot, y_dot, theta_dot] = read3(&self.velocities, index)?;
+        Some(PoseVelocity {
+            x,
+            y,
+            theta,
+            x_dot,
+            y_dot,
+            theta_dot,
+        })
+    }
+}
+
+impl<M: Accelerations> State<M>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    /// Accelerations q̈.
+    pub fn qdd(&self) -> &Vector<M::Dim> {
+        &self.accelerations
+    }
+
+    /// Pose, velocity and acceleration of body `index`; `None` past the end.
+    pub fn body(&self, index: usize) -> Option<BodyState> {
+        let [x, y, theta] = read3(&self.q, index)?;
+        let [x_dot, y_dot, theta_dot] = read3(&self.velocities, index)?;
+        let [x_ddot, y_ddot, theta_ddot] = read3(&self.accelerations, index)?;
+        Some(BodyState {
+            x,
+            y,
+            theta,
+            x_dot,
+            y_dot,
+            theta_dot,
+            x_ddot,
+            y_ddot,
+            theta_ddot,
+        })
+    }
+}
+
+/// Number of CSV column groups (q; q, q̇; q, q̇, q̈) for a scene's outputs.
+fn column_groups(outputs: Outputs) -> usize {
+    match outputs {
+        Outputs::Positions => 1,
+        Outputs::Velocities => 2,
+        Outputs::Accelerations => 3,
+    }
+}
+
+/// Writes the CSV header line: `t`, every coordinate name, then (when the scene computes them)
+/// the names with `_dot`, then with `_ddot` (`t,piston.x,…,piston.x_dot,…,piston.x_ddot,…\n`).
 ///
 /// A coordinate without a name is written as `q<index>`.
 ///
@@ -118,7 +219,8 @@ where
 {
     out.write_char('t')?;
     let n = mechanism.dim().value();
-    for suffix in ["", "_dot", "_ddot"] {
+    let suffixes = ["", "_dot", "_ddot"];
+    for suffix in suffixes.iter().take(column_groups(mechanism.outputs())) {
         for index in 0..n {
             match mechanism.coordinate_name(index) {
                 Some(name) => write!(out, ",{name}{suffix}")?,
@@ -137,9 +239,10 @@ where
         Self {
             t: self.t,
             q: self.q.clone(),
-            qd: self.qd.clone(),
-            qdd: self.qdd.clone(),
+            velocities: self.velocities.clone(),
+            accelerations: self.accelerations.clone(),
             iterations: self.iterations,
+            outputs: self.outputs,
             mechanism: PhantomData,
         }
     }
@@ -153,9 +256,10 @@ where
         f.debug_struct("State")
             .field("t", &self.t)
             .field("q", &self.q.as_slice())
-            .field("qd", &self.qd.as_slice())
-            .field("qdd", &self.qdd.as_slice())
+            .field("qd", &self.velocities.as_slice())
+            .field("qdd", &self.accelerations.as_slice())
             .field("iterations", &self.iterations)
+            .field("outputs", &self.outputs)
             .finish()
     }
 }
@@ -167,11 +271,11 @@ mod tests {
     use std::string::String;
 
     fn sample() -> State<Pendulum> {
-        let mut state = State::zeros(nalgebra::Const);
+        let mut state = State::new(&Pendulum::default());
         state.t = 0.5;
         state.q = Vector::from([1.0, 2.0, 3.0]);
-        state.qd = Vector::from([0.1, -0.0, 1e-20]);
-        state.qdd = Vector::from([-1.5, 2.5, 1e20]);
+        state.velocities = Vector::from([0.1, -0.0, 1e-20]);
+        state.accelerations = Vector::from([-1.5, 2.5, 1e20]);
         state
     }
 
@@ -206,8 +310,8 @@ mod tests {
         let expected = [state.t]
             .into_iter()
             .chain(state.q.iter().copied())
-            .chain(state.qd.iter().copied())
-            .chain(state.qdd.iter().copied());
+            .chain(state.velocities.iter().copied())
+            .chain(state.accelerations.iter().copied());
         assert!(values.iter().copied().eq(expected));
         assert_eq!(header.split(',').count(), values.len());
     }

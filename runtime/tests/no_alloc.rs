@@ -6,6 +6,7 @@
 mod common;
 
 use core::alloc::{GlobalAlloc, Layout};
+use core::cell::Cell;
 use core::fmt::{self, Write};
 use core::sync::atomic::{AtomicUsize, Ordering};
 use std::alloc::System;
@@ -15,6 +16,19 @@ use mechgen_runtime::{Simulation, Solver, write_csv_header};
 
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
 
+thread_local! {
+    // Only the measuring thread counts: libtest's own threads may allocate meanwhile (output
+    // capture, timing), which made a global count flaky under load. A `const` `Cell` needs no
+    // allocation or destructor, so reading it inside the allocator is safe.
+    static COUNTING: Cell<bool> = const { Cell::new(false) };
+}
+
+fn count() {
+    if COUNTING.with(Cell::get) {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
 struct Counting;
 
 // Implementing `GlobalAlloc` requires `unsafe`; this impl only counts and forwards to `System`,
@@ -22,17 +36,17 @@ struct Counting;
 #[allow(unsafe_code)]
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        count();
         unsafe { System.alloc(layout) }
     }
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        count();
         unsafe { System.alloc_zeroed(layout) }
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        count();
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 
@@ -56,6 +70,7 @@ impl Write for Sink {
 
 #[test]
 fn solving_and_stepping_never_allocate() {
+    COUNTING.with(|c| c.set(true));
     drop(core::hint::black_box(Box::new(0_u8)));
     let before = ALLOCATIONS.load(Ordering::SeqCst);
     assert!(before > 0, "the counting allocator is not installed");

@@ -4,12 +4,12 @@
 use mechgen_examples::accuracy::ErrorTracker;
 use mechgen_examples::closed_form;
 use mechgen_examples::scenes::{FourBar, PistonCrank};
-use mechgen_runtime::{Mechanism, Simulation, Solver, Vector};
+use mechgen_runtime::{Accelerations, Mechanism, Simulation, Solver, Vector, Velocities};
 
 /// The foundation's accuracy target: max error ≤ 1e-10 of each quantity's largest magnitude.
 const TOLERANCE: f64 = 1e-10;
 
-fn one_revolution<M: Mechanism<Dim = mechgen_runtime::nalgebra::Const<N>>, const N: usize>(
+fn one_revolution<M: Accelerations<Dim = mechgen_runtime::nalgebra::Const<N>>, const N: usize>(
     mechanism: M,
     period: f64,
     exact: impl Fn(f64) -> closed_form::Kinematics<N>,
@@ -20,8 +20,8 @@ fn one_revolution<M: Mechanism<Dim = mechgen_runtime::nalgebra::Const<N>>, const
         .run(period, 360, |state| {
             tracker.add(
                 state.q.as_slice(),
-                state.qd.as_slice(),
-                state.qdd.as_slice(),
+                state.qd().as_slice(),
+                state.qdd().as_slice(),
                 &exact(state.t),
             );
         })
@@ -94,8 +94,8 @@ fn seed_matches_the_reference_table_at_every_row() {
         let state = simulation.step_to(row.t).expect("solves");
         tracker.add(
             state.q.as_slice(),
-            state.qd.as_slice(),
-            state.qdd.as_slice(),
+            state.qd().as_slice(),
+            state.qdd().as_slice(),
             row,
         );
     }

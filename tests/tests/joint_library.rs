@@ -5,7 +5,7 @@
 //! and acceleration right-hand sides (ν, and γ including Φ_tt) are checked, not only positions.
 
 use mechgen_runtime::nalgebra::Const;
-use mechgen_runtime::{Mechanism, Simulation, Solver, mechanism};
+use mechgen_runtime::{Simulation, Solver, mechanism};
 use num_dual::{DualNum, second_derivative};
 
 const A: f64 = 0.4;
@@ -88,14 +88,14 @@ mechanism! {
 /// largest magnitude, as everywhere in the project).
 fn check<M, const N: usize>(mechanism: M, exact: impl Fn(f64) -> [[f64; N]; 3])
 where
-    M: Mechanism<Dim = Const<N>>,
+    M: mechgen_runtime::Accelerations<Dim = Const<N>>,
 {
     let mut simulation = Simulation::new(Solver::new(mechanism), 0.0).expect("assembles");
     let (mut error, mut scale) = ([0.0f64; 3], [0.0f64; 3]);
     simulation
         .run(2.0, 200, |state| {
             let reference = exact(state.t);
-            for (k, solved) in [&state.q, &state.qd, &state.qdd].into_iter().enumerate() {
+            for (k, solved) in [&state.q, state.qd(), state.qdd()].into_iter().enumerate() {
                 for (s, r) in solved.iter().zip(reference[k]) {
                     error[k] = error[k].max((s - r).abs());
                     scale[k] = scale[k].max(r.abs());

@@ -5,6 +5,7 @@
 //! other test thread allocates while it counts.
 
 use core::alloc::{GlobalAlloc, Layout};
+use core::cell::Cell;
 use core::fmt::{self, Write};
 use core::sync::atomic::{AtomicUsize, Ordering};
 use std::alloc::System;
@@ -14,23 +15,36 @@ use mechgen_runtime::{Simulation, Solver};
 
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
 
+thread_local! {
+    // Only the measuring thread counts: libtest's own threads may allocate meanwhile (output
+    // capture, timing), which made a global count flaky under load. A `const` `Cell` needs no
+    // allocation or destructor, so reading it inside the allocator is safe.
+    static COUNTING: Cell<bool> = const { Cell::new(false) };
+}
+
+fn count() {
+    if COUNTING.with(Cell::get) {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
 struct Counting;
 
 // Implementing `GlobalAlloc` requires `unsafe`; this impl only counts and forwards to `System`.
 #[allow(unsafe_code)]
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        count();
         unsafe { System.alloc(layout) }
     }
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        count();
         unsafe { System.alloc_zeroed(layout) }
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        count();
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 
@@ -54,6 +68,7 @@ impl Write for Sink {
 
 #[test]
 fn generated_scenes_solve_without_allocating() {
+    COUNTING.with(|c| c.set(true));
     // The counter is live: a real allocation is seen.
     let before = ALLOCATIONS.load(Ordering::SeqCst);
     drop(core::hint::black_box(Box::new(0_u8)));

@@ -4,7 +4,7 @@
 use mechgen_cli::Interpreted;
 use mechgen_examples::scenes::{FourBar, PistonCrank};
 use mechgen_runtime::nalgebra::{DMatrix, DVector, Dyn};
-use mechgen_runtime::{Matrix, Mechanism, Vector};
+use mechgen_runtime::{Accelerations, Matrix, Mechanism, Vector, Velocities};
 use proptest::prelude::*;
 
 fn interpreted(file: &str) -> Interpreted {
@@ -67,7 +67,7 @@ fn agree<M>(
     t: f64,
 ) -> Result<(), TestCaseError>
 where
-    M: Mechanism,
+    M: Accelerations,
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
 {
     let dim = generated.dim();

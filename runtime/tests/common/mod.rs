@@ -6,7 +6,10 @@
 
 use mechgen_runtime::math::{cos, sin};
 use mechgen_runtime::nalgebra::Const;
-use mechgen_runtime::{Matrix, Mechanism, ParameterError, Vector};
+use mechgen_runtime::{
+    Accelerations, Lu, Matrix, Mechanism, Outputs, ParameterError, SolveError, Vector, Velocities,
+    solve_accelerations, solve_velocities,
+};
 
 pub type Q = Vector<Const<9>>;
 
@@ -177,11 +180,37 @@ impl Mechanism for SliderCrank {
         }
     }
 
+    fn outputs(&self) -> Outputs {
+        Outputs::Accelerations
+    }
+
+    fn derivatives(
+        &self,
+
+        q: &Vector<Self::Dim>,
+
+        t: f64,
+
+        factors: &Lu<Self::Dim>,
+
+        qd: &mut Vector<Self::Dim>,
+
+        qdd: &mut Vector<Self::Dim>,
+    ) -> Result<(), SolveError> {
+        solve_velocities(self, q, t, factors, qd)?;
+
+        solve_accelerations(self, q, qd, t, factors, qdd)
+    }
+}
+
+impl Velocities for SliderCrank {
     fn nu(&self, _: &Q, _: f64, out: &mut Q) {
         *out = Q::zeros();
         out[2] = self.parameters[2];
     }
+}
 
+impl Accelerations for SliderCrank {
     fn gamma(&self, q: &Q, qd: &Q, _: f64, out: &mut Q) {
         let [r, l, ..] = self.parameters;
         let (th1, th2, w1, w2) = (q[2], q[5], qd[2], qd[5]);
