@@ -6,6 +6,7 @@
 //! elementary functions come from `::mechgen_runtime::math`. Zero entries are never computed: the
 //! output is cleared once and only non-zeros are written.
 
+use std::cell::RefCell;
 use std::collections::{BTreeSet, HashSet};
 
 use proc_macro2::{Ident, Literal, Span, TokenStream};
@@ -42,7 +43,6 @@ pub fn emit(model: &Model, kin: &Kinematics) -> TokenStream {
 /// Emits the whole item set for a scene: the parameter struct, its constants, the `Mechanism`
 /// implementation and the named body accessors.
 pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> TokenStream {
-    let _ = options;
     let name = &model.name;
     let vis = &model.vis;
     let docs = &model.docs;
@@ -87,7 +87,15 @@ pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> T
         quote! { (#r, #c) }
     });
 
-    let cx = Context { model };
+    let cx = Context {
+        model,
+        options,
+        helpers: RefCell::new(Vec::new()),
+    };
+    let vector_type =
+        quote!(&mut ::mechgen_runtime::Vector<::mechgen_runtime::nalgebra::Const<#n_lit>>);
+    let matrix_type =
+        quote!(&mut ::mechgen_runtime::Matrix<::mechgen_runtime::nalgebra::Const<#n_lit>>);
     let vector = |values: &[Id], target: TokenStream| {
         let clear = clear_if_sparse(&model.arena, values, &target);
         (vector_outputs(values, &target), clear)
@@ -109,28 +117,49 @@ pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> T
         let (outputs, clear) = vector(&kin.guess, quote!(q));
         cx.function(&outputs, clear)
     };
+    let out_vector = [("out", vector_type.clone())];
     let phi = {
         let (outputs, clear) = vector(&kin.phi, quote!(out));
-        cx.function(&outputs, clear)
+        cx.bounded("phi", &outputs, clear, &out_vector, false)
     };
     let jacobian = {
         let (outputs, clear) = jacobian_outputs(quote!(out));
-        cx.function(&outputs, clear)
+        cx.bounded(
+            "jacobian",
+            &outputs,
+            clear,
+            &[("out", matrix_type.clone())],
+            false,
+        )
     };
     let phi_and_jacobian = {
         let (mut outputs, mut clear) = vector(&kin.phi, quote!(phi));
         let (jac_outputs, jac_clear) = jacobian_outputs(quote!(jacobian));
         outputs.extend(jac_outputs);
         clear.extend(jac_clear);
-        cx.function(&outputs, clear)
+        let outs = [
+            ("phi", vector_type.clone()),
+            ("jacobian", matrix_type.clone()),
+        ];
+        cx.bounded("phi_and_jacobian", &outputs, clear, &outs, false)
     };
     let nu = kin.nu.as_deref().map(|nu| {
         let (outputs, clear) = vector(nu, quote!(out));
-        cx.function(&outputs, clear)
+        cx.bounded("nu", &outputs, clear, &out_vector, false)
     });
     let gamma = kin.gamma.as_deref().map(|gamma| {
         let (outputs, clear) = vector(gamma, quote!(out));
-        cx.function(&outputs, clear)
+        cx.bounded("gamma", &outputs, clear, &out_vector, true)
+    });
+    let helpers = cx.helpers.into_inner();
+    let helpers_impl = (!helpers.is_empty()).then(|| {
+        quote! {
+            /// Parts of the kinematic functions, split to keep each function small enough for
+            /// rustc (`CodegenOptions::max_function_size`).
+            impl #name {
+                #(#helpers)*
+            }
+        }
     });
 
     let guess_body = guess.body;
@@ -381,6 +410,8 @@ pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> T
 
         #accelerations_impl
 
+        #helpers_impl
+
         #[doc = #bodies_doc]
         #vis trait #bodies_trait {
             #(#accessor_decls)*
@@ -445,11 +476,109 @@ impl Function {
 
 struct Context<'a> {
     model: &'a Model,
+    options: &'a CodegenOptions,
+    /// Helper functions of split bodies, emitted in an inherent `impl` block.
+    helpers: RefCell<Vec<TokenStream>>,
 }
 
 impl Context<'_> {
     fn arena(&self) -> &Arena {
         &self.model.arena
+    }
+
+    /// Like [`Context::function`], but a body larger than `max_function_size` operations is
+    /// split: its outputs are grouped in order into parts of bounded size, each emitted as a
+    /// helper method (recomputing the few shared sub-expressions a part needs), and the body
+    /// calls them in turn. `outs` are the output parameters (name, type) passed to each part.
+    fn bounded(
+        &self,
+        name: &str,
+        outputs: &[(TokenStream, Id)],
+        clear: TokenStream,
+        outs: &[(&str, TokenStream)],
+        reads_qd: bool,
+    ) -> Function {
+        let groups = self.partition(outputs);
+        if groups.len() <= 1 {
+            return self.function(outputs, clear);
+        }
+        let n = idx(self.model.dim());
+        let vector = quote!(::mechgen_runtime::Vector<::mechgen_runtime::nalgebra::Const<#n>>);
+        let mut calls = Vec::new();
+        let mut counts = OpCounts::default();
+        for (k, group) in groups.iter().enumerate() {
+            // Only the outputs this part writes (a Φ part of `phi_and_jacobian` takes no Φ_q).
+            let written: Vec<&(&str, TokenStream)> = outs
+                .iter()
+                .filter(|(o, _)| group.iter().any(|(target, _)| writes_to(target, o)))
+                .collect();
+            let out_names: Vec<Ident> = written
+                .iter()
+                .map(|(o, _)| format_ident!("{}", o))
+                .collect();
+            let out_types: Vec<&TokenStream> = written.iter().map(|(_, ty)| ty).collect();
+            let part = self.function(group, TokenStream::new());
+            counts = counts + part.counts;
+            let [q, qd, t] = &part.args;
+            let part_name = format_ident!("{}_part{}", name, k);
+            let body = part.body;
+            let (qd_param, qd_arg) = if reads_qd {
+                (quote!(#qd: &#vector,), quote!(qd,))
+            } else {
+                (TokenStream::new(), TokenStream::new())
+            };
+            self.helpers.borrow_mut().push(quote! {
+                #[inline(never)]
+                fn #part_name(
+                    &self,
+                    #q: &#vector,
+                    #qd_param
+                    #t: f64,
+                    #(#out_names: #out_types),*
+                ) {
+                    #body
+                }
+            });
+            calls.push(quote! { self.#part_name(q, #qd_arg t, #(#out_names),*); });
+        }
+        let qd = if reads_qd { "qd" } else { "_qd" };
+        Function {
+            body: quote! { #clear #(#calls)* },
+            args: [
+                format_ident!("q"),
+                format_ident!("{}", qd),
+                format_ident!("t"),
+            ],
+            counts,
+        }
+    }
+
+    /// Non-zero `outputs`, in order, grouped so that the DAG each group evaluates has at most
+    /// `max_function_size` nodes (an output larger than that on its own is a group by itself).
+    fn partition(&self, outputs: &[(TokenStream, Id)]) -> Vec<Vec<(TokenStream, Id)>> {
+        let arena = self.arena();
+        let max = self.options.max_function_size.max(1);
+        // `group_of[node]` is the group whose DAG already holds the node (0: none yet).
+        let mut group_of = vec![0usize; arena.len()];
+        let mut groups: Vec<Vec<(TokenStream, Id)>> = vec![Vec::new()];
+        let mut size = 0;
+        let mut fresh = Vec::new();
+        for (target, id) in outputs.iter().filter(|(_, id)| !arena.is_zero(*id)) {
+            new_nodes(arena, *id, &group_of, groups.len(), &mut fresh);
+            if size + fresh.len() > max && !groups.last().is_some_and(Vec::is_empty) {
+                groups.push(Vec::new());
+                size = 0;
+                new_nodes(arena, *id, &group_of, groups.len(), &mut fresh);
+            }
+            for node in &fresh {
+                group_of[node.index()] = groups.len();
+            }
+            size += fresh.len();
+            if let Some(group) = groups.last_mut() {
+                group.push((target.clone(), *id));
+            }
+        }
+        groups
     }
 
     /// A function body writing `outputs` (non-zero entries; zeros are cleared in one call).
@@ -601,6 +730,26 @@ impl Context<'_> {
             },
             _ => "e".to_owned(),
         }
+    }
+}
+
+/// True if an output target (`out[3]`, `jacobian[(1, 2)]`) writes to the parameter `name`.
+fn writes_to(target: &TokenStream, name: &str) -> bool {
+    matches!(target.clone().into_iter().next(), Some(proc_macro2::TokenTree::Ident(i)) if i == name)
+}
+
+/// The nodes reachable from `root` not yet in group `group`, into `fresh` (iterative: scenes can
+/// be deep).
+fn new_nodes(arena: &Arena, root: Id, group_of: &[usize], group: usize, fresh: &mut Vec<Id>) {
+    fresh.clear();
+    let mut seen = HashSet::new();
+    let mut stack = vec![root];
+    while let Some(id) = stack.pop() {
+        if group_of[id.index()] == group || !seen.insert(id) {
+            continue;
+        }
+        fresh.push(id);
+        stack.extend(arena.children(id));
     }
 }
 

@@ -56,6 +56,22 @@ impl OpCounts {
     }
 }
 
+impl core::ops::Add for OpCounts {
+    type Output = OpCounts;
+
+    fn add(self, other: OpCounts) -> OpCounts {
+        OpCounts {
+            trig: self.trig + other.trig,
+            sqrt: self.sqrt + other.sqrt,
+            exp_ln: self.exp_ln + other.exp_ln,
+            mul: self.mul + other.mul,
+            add: self.add + other.add,
+            div: self.div + other.div,
+            neg: self.neg + other.neg,
+        }
+    }
+}
+
 impl fmt::Display for OpCounts {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
