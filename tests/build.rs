@@ -10,6 +10,7 @@ fn main() {
     let source = std::fs::read_to_string(&scene).expect("the seed scene is readable");
     let options = mechgen::CodegenOptions {
         max_function_size: 12,
+        ..Default::default()
     };
     let code = mechgen::expand_str_with(&source, &options).unwrap_or_else(|e| panic!("{e}"));
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));

@@ -2,21 +2,39 @@
 //! evaluating Φ and Φ_q, and one full kinematic step (position, velocity, acceleration at one
 //! time, warm-started with the predictor) through the runtime's solver.
 //!
+//! The finite-difference and automatic-differentiation Jacobians of the accuracy report
+//! (`mechgen_examples::report`) are timed in the same groups, and steps use the report's
+//! reference setting (its tolerance and steps per revolution), so the report's per-call and
+//! per-step figures can be checked against these (the report prints criterion's beside its own).
+//!
 //! `cargo bench -p mechgen-examples --bench kinematics`
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use mechgen_cli::Interpreted;
+use mechgen_examples::report::{AutoDiff, CentralDifference, ForwardDifference, Plan};
 use mechgen_examples::scenes::{FourBar, PistonCrank};
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{Matrix, Mechanism, Simulation, Solver, Storage, Vector};
 
-fn interpreted(file: &str) -> Interpreted {
+/// The seed generated naively (no folding, no simplification, no shared sub-expressions) by
+/// the package's `build.rs`: the baseline the lean code is timed against. Bench-only, so the
+/// examples do not pay for compiling it.
+#[allow(missing_docs, dead_code)]
+mod naive {
+    include!(concat!(env!("OUT_DIR"), "/piston_crank_naive.rs"));
+}
+
+/// The IR of a scene's `.mech` twin.
+fn scene(file: &str) -> mechgen::Scene {
     let path = format!("{}/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
     let source = std::fs::read_to_string(&path).expect("scene file");
-    let scene = mechgen::compile_str(&source).unwrap_or_else(|e| panic!("{path}: {e}"));
-    Interpreted::new(&scene)
+    mechgen::compile_str(&source).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
+
+fn interpreted(file: &str) -> Interpreted {
+    Interpreted::new(&scene(file))
 }
 
 /// Benchmarks one mechanism under `label`: Φ, Φ_q, Φ+Φ_q at an assembled state, then a step.
@@ -25,8 +43,12 @@ where
     M: Mechanism + Clone,
     DefaultAllocator: Storage<M::Dim>,
 {
-    let mut simulation =
-        Simulation::new(Solver::new(mechanism.clone()), 0.0).expect("scene assembles");
+    let reference = Plan::full().reference;
+    let mut simulation = Simulation::new(
+        Solver::with_options(mechanism.clone(), reference.options()),
+        0.0,
+    )
+    .expect("scene assembles");
     let q = simulation.state().q.clone();
     let dim = mechanism.dim();
     let mut phi = Vector::<M::Dim>::zeros_generic(dim, mechgen_runtime::nalgebra::Const::<1>);
@@ -45,8 +67,9 @@ where
             mechanism.phi_and_jacobian(black_box(&q), black_box(t), &mut phi, &mut jacobian);
         });
     });
-    // 360 steps per revolution, as in the examples; time keeps advancing across iterations.
-    let h = period / 360.0;
+    // The report's reference steps per revolution (360, as in the examples); time keeps
+    // advancing across iterations.
+    let h = period / reference.steps as f64;
     let mut time = 0.0;
     group.bench_function("step", |b| {
         b.iter(|| {
@@ -61,6 +84,25 @@ where
 fn kinematics(c: &mut Criterion) {
     let seed_period = 2.0 * std::f64::consts::PI / PistonCrank::default().omega;
     bench_scene(c, "seed/generated", PistonCrank::default(), seed_period);
+    // The report's Jacobian baselines, around the same generated scene.
+    let seed = PistonCrank::default();
+    bench_scene(
+        c,
+        "seed/forward_difference",
+        ForwardDifference::new(seed),
+        seed_period,
+    );
+    bench_scene(
+        c,
+        "seed/central_difference",
+        CentralDifference::new(seed),
+        seed_period,
+    );
+    let seed_ad = AutoDiff::new(seed, &scene("piston_crank.mech")).expect("twin scenes match");
+    bench_scene(c, "seed/autodiff", seed_ad, seed_period);
+    // The same seed emitted naively (no folding, no simplification, no sharing): what the lean
+    // emission saves, measured in the same run.
+    bench_scene(c, "seed/naive", naive::PistonCrank::default(), seed_period);
     bench_scene(
         c,
         "seed/interpreted",
@@ -69,6 +111,21 @@ fn kinematics(c: &mut Criterion) {
     );
     let four_bar_period = 2.0 * std::f64::consts::PI / FourBar::default().omega;
     bench_scene(c, "four_bar/generated", FourBar::default(), four_bar_period);
+    let four_bar = FourBar::default();
+    bench_scene(
+        c,
+        "four_bar/forward_difference",
+        ForwardDifference::new(four_bar),
+        four_bar_period,
+    );
+    bench_scene(
+        c,
+        "four_bar/central_difference",
+        CentralDifference::new(four_bar),
+        four_bar_period,
+    );
+    let four_bar_ad = AutoDiff::new(four_bar, &scene("four_bar.mech")).expect("twin scenes match");
+    bench_scene(c, "four_bar/autodiff", four_bar_ad, four_bar_period);
     bench_scene(
         c,
         "four_bar/interpreted",

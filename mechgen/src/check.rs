@@ -10,7 +10,7 @@ use proc_macro2::Span;
 use syn::Ident;
 
 use crate::error::Errors;
-use crate::expr::{Arena, Func, Id, Var};
+use crate::expr::{Arena, Func, Id, Node, Var};
 use crate::model::{Body, Constraint, ConstraintKind, Driven, Model, Outputs, Param, Point};
 use crate::spec::{BinOp, DriverKind, Expr, ExprKind, JointKind, PointRef, Spec};
 
@@ -21,9 +21,17 @@ use crate::spec::{BinOp, DriverKind, Expr, ExprKind, JointKind, PointRef, Spec};
 /// itself or between two ground bodies, drivers on ground bodies, zero axes or distances,
 /// `t` outside drivers, unknown functions, and drivers not matching the degrees of freedom.
 pub fn check(spec: &Spec) -> Result<Model, Errors> {
+    check_into(spec, Arena::new())
+}
+
+/// [`check`] building into a given arena ([`Arena::unsimplified`] for the naive baseline).
+///
+/// # Errors
+/// As [`check`].
+pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
     let mut cx = Checker {
         errors: Errors::default(),
-        arena: Arena::new(),
+        arena,
         bodies: HashMap::new(),
         params: HashMap::new(),
         prismatic: HashMap::new(),
@@ -438,7 +446,15 @@ impl Checker {
     fn constant(&mut self, e: &Expr) -> f64 {
         let before = self.errors.len();
         let id = self.lower_with(e, false, false);
-        match self.arena.as_const(id) {
+        // An unsimplified arena (naive baseline) does not fold: evaluate instead.
+        let value = self.arena.as_const(id).or_else(|| {
+            let constant = !self
+                .arena
+                .any_node(id, |n| matches!(n, Node::Var(_) | Node::Param(_)));
+            let value = crate::interpret::eval(&self.arena, id, &crate::interpret::Env::default());
+            (constant && value.is_finite()).then_some(value)
+        });
+        match value {
             Some(v) => v,
             None => {
                 if self.errors.len() == before {

@@ -25,12 +25,17 @@ pub struct CodegenOptions {
     /// bodies are split into helper functions of about this size. rustc's compile time grows
     /// much faster than linearly in the size of one function, so huge scenes need this.
     pub max_function_size: usize,
+    /// The naive baseline, for measuring what the lean emission saves: no constant folding or
+    /// algebraic simplification (the scene is compiled into [`Arena::unsimplified`]) and no
+    /// shared sub-expressions (every use evaluated again). Never for production code.
+    pub naive: bool,
 }
 
 impl Default for CodegenOptions {
     fn default() -> Self {
         Self {
             max_function_size: 2_000,
+            naive: false,
         }
     }
 }
@@ -609,7 +614,11 @@ impl Context<'_> {
         let mut loads: Vec<(Var, TokenStream)> = Vec::new();
         let mut funcs = BTreeSet::new();
         let mut used = [false; 3];
-        let counts = OpCounts::of(arena, &order);
+        let counts = if self.options.naive {
+            OpCounts::of_tree(arena, &roots)
+        } else {
+            OpCounts::of(arena, &order)
+        };
 
         for &id in &order {
             let node = arena.node(id);
@@ -667,8 +676,10 @@ impl Context<'_> {
                 }
             };
             let is_leaf = matches!(node, Node::Const(_) | Node::Param(_) | Node::Var(Var::T));
+            // Coordinates are loaded once; the naive baseline shares nothing else.
+            let shared = matches!(node, Node::Call(..)) || uses[id.index()] > 1;
             let bind =
-                !is_leaf && (matches!(node, Node::Var(_) | Node::Call(..)) || uses[id.index()] > 1);
+                !is_leaf && (matches!(node, Node::Var(_)) || (shared && !self.options.naive));
             if bind {
                 let ident = names.fresh(&self.suggest(id));
                 let statement = quote! { let #ident = #tokens; };

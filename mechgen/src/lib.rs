@@ -90,6 +90,23 @@ pub fn expand_or_errors(tokens: TokenStream) -> TokenStream {
     }
 }
 
+/// Parses, checks and differentiates a `.mech` source for emission with `options` (the naive
+/// baseline compiles into an unsimplified arena).
+///
+/// # Errors
+/// As [`compile_str`].
+pub fn compile_str_with(source: &str, options: &emit::CodegenOptions) -> Result<Scene, Errors> {
+    let spec = parse::parse_str(source)?;
+    let arena = if options.naive {
+        expr::Arena::unsimplified()
+    } else {
+        expr::Arena::new()
+    };
+    let mut model = check::check_into(&spec, arena)?;
+    let kinematics = kinematics::derive(&mut model);
+    Ok(Scene { model, kinematics })
+}
+
 /// Generated code for a `.mech` source with explicit options, as tokens: what a `build.rs`
 /// writes into `OUT_DIR` (see the `builder` module for assembling large scenes in code).
 ///
@@ -99,7 +116,7 @@ pub fn expand_str_with(
     source: &str,
     options: &emit::CodegenOptions,
 ) -> Result<TokenStream, Errors> {
-    let scene = compile_str(source)?;
+    let scene = compile_str_with(source, options)?;
     Ok(emit::emit_with(&scene.model, &scene.kinematics, options))
 }
 

@@ -40,7 +40,9 @@ impl OpCounts {
                 Node::Powi(_, n) => {
                     // Repeated squaring: ⌊log2 n⌋ squarings plus one product per extra set bit.
                     let e = n.unsigned_abs();
-                    c.mul += (31 - e.leading_zeros()) as usize + e.count_ones() as usize - 1;
+                    if e > 1 {
+                        c.mul += (31 - e.leading_zeros()) as usize + e.count_ones() as usize - 1;
+                    }
                     if n < 0 {
                         c.div += 1;
                     }
@@ -53,6 +55,25 @@ impl OpCounts {
             }
         }
         c
+    }
+}
+
+impl OpCounts {
+    /// Counts the operations of evaluating `roots` as trees: every use of a shared
+    /// sub-expression evaluated again (the naive baseline, without common-subexpression
+    /// elimination).
+    pub fn of_tree(arena: &Arena, roots: &[Id]) -> Self {
+        let order = topological_order(arena, roots);
+        let mut subtree = vec![OpCounts::default(); arena.len()];
+        for &id in &order {
+            let own = OpCounts::of(arena, &[id]);
+            subtree[id.index()] = arena
+                .children(id)
+                .fold(own, |total, child| total + subtree[child.index()]);
+        }
+        roots.iter().fold(OpCounts::default(), |total, root| {
+            total + subtree[root.index()]
+        })
     }
 }
 
@@ -97,6 +118,8 @@ pub struct FunctionCounts {
 /// for its doc comments: over the DAG reachable from the non-zero outputs, each node once.
 pub fn function_counts(scene: &Scene) -> Vec<FunctionCounts> {
     let arena = &scene.model.arena;
+    // A naive scene (unsimplified arena) is emitted without sharing: count its trees.
+    let naive = !arena.simplifies();
     scene
         .kinematics
         .function_outputs(arena)
@@ -104,7 +127,11 @@ pub fn function_counts(scene: &Scene) -> Vec<FunctionCounts> {
         .map(|(function, roots)| FunctionCounts {
             function,
             outputs: roots.len(),
-            counts: OpCounts::of(arena, &topological_order(arena, &roots)),
+            counts: if naive {
+                OpCounts::of_tree(arena, &roots)
+            } else {
+                OpCounts::of(arena, &topological_order(arena, &roots))
+            },
         })
         .collect()
 }
@@ -123,4 +150,33 @@ pub fn table(scene: &Scene) -> String {
         );
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::expr::Var;
+
+    #[test]
+    fn integer_powers_count_their_multiplications() {
+        let mut a = Arena::unsimplified();
+        let x = a.var(Var::Q(0));
+        let count = |a: &Arena, id| OpCounts::of(a, &[id]).mul;
+        for (n, muls) in [(0, 0), (1, 0), (2, 1), (3, 2), (4, 2), (5, 3), (-2, 1)] {
+            let p = a.powi(x, n);
+            assert_eq!(count(&a, p), muls, "x^{n}");
+        }
+    }
+
+    #[test]
+    fn trees_count_every_use_and_dags_count_once() {
+        let mut a = Arena::new();
+        let x = a.var(Var::Q(0));
+        let s = a.sin(x);
+        let two_uses = a.mul(s, s);
+        let dag = OpCounts::of(&a, &topological_order(&a, &[two_uses]));
+        let tree = OpCounts::of_tree(&a, &[two_uses]);
+        assert_eq!((dag.trig, dag.mul), (1, 1));
+        assert_eq!((tree.trig, tree.mul), (2, 1));
+    }
 }

@@ -65,15 +65,25 @@ fn operation_counts() {
     }
 }
 
-/// The Jacobian's sparsity and the operation table of every generated function.
+/// The Jacobian's sparsity and the operation table of every generated function, lean (what
+/// users get) and naive (no folding, no simplification, no sharing: the baseline it saves on).
 fn operation_table(source: &str) -> Result<String, mechgen::Errors> {
-    let scene = mechgen::compile_str(source)?;
-    let n = scene.model.dim();
+    let lean = mechgen::compile_str(source)?;
+    let naive_options = mechgen::CodegenOptions {
+        naive: true,
+        ..Default::default()
+    };
+    let naive = mechgen::compile_str_with(source, &naive_options)?;
+    let n = lean.model.dim();
     let mut table = format!(
-        "{n} coordinates; Jacobian: {} structural non-zeros of {}\n\n",
-        scene.kinematics.jacobian.len(),
-        n * n
+        "{n} coordinates; Jacobian: {} structural non-zeros of {} (naive: {})\n\n",
+        lean.kinematics.jacobian.len(),
+        n * n,
+        naive.kinematics.jacobian.len()
     );
-    table += &mechgen::stats::table(&scene);
+    table += "lean (folded, simplified, shared sub-expressions):\n";
+    table += &mechgen::stats::table(&lean);
+    table += "\nnaive (no folding or simplification, every use evaluated):\n";
+    table += &mechgen::stats::table(&naive);
     Ok(table)
 }
