@@ -5,7 +5,7 @@
 
 use mechgen_examples::closed_form;
 use mechgen_examples::demo::{self, Options};
-use mechgen_examples::plot::{self, Panel, Series};
+use mechgen_examples::plot::{Panel, Series};
 use mechgen_examples::scenes::{FourBar, FourBarBodies};
 use mechgen_runtime::State;
 
@@ -79,17 +79,5 @@ fn main() {
         },
     ];
     let title = "Crank-rocker four-bar: rocker motion over one crank revolution";
-    match plot::write_svg(&options.svg, title, "crank angle (deg)", &panels) {
-        Ok(()) => println!("plot: {}", options.svg.display()),
-        Err(e) => eprintln!("warning: {e} ({})", options.svg.display()),
-    }
-    if let Some(path) = &options.csv {
-        match run.write_csv(path) {
-            Ok(()) => println!("csv: {} ({} rows)", path.display(), run.states.len()),
-            Err(e) => {
-                eprintln!("error: writing {}: {e}", path.display());
-                std::process::exit(1);
-            }
-        }
-    }
+    run.write_outputs(&options, title, "crank angle (deg)", &panels);
 }

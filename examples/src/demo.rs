@@ -13,6 +13,7 @@ use mechgen_runtime::{
 
 use crate::accuracy::{ErrorTracker, RelativeErrors};
 use crate::closed_form::Kinematics;
+use crate::plot::{self, Panel};
 
 /// Command-line options of the example binaries.
 #[derive(Debug, Clone, Default)]
@@ -135,6 +136,30 @@ impl<M: Mechanism<Dim = Const<N>>, const N: usize> Revolution<M, N> {
         }
         std::fs::write(path, text)?;
         Ok(())
+    }
+
+    /// Writes the SVG plot (a failure is a warning: the table was printed already) and, when
+    /// asked for, the CSV (a failure exits with status 1).
+    pub fn write_outputs(
+        &self,
+        options: &Options,
+        title: &str,
+        x_label: &str,
+        panels: &[Panel<'_>],
+    ) {
+        match plot::write_svg(&options.svg, title, x_label, panels) {
+            Ok(()) => println!("plot: {}", options.svg.display()),
+            Err(e) => eprintln!("warning: {e} ({})", options.svg.display()),
+        }
+        if let Some(path) = &options.csv {
+            match self.write_csv(path) {
+                Ok(()) => println!("csv: {} ({} rows)", path.display(), self.states.len()),
+                Err(e) => {
+                    eprintln!("error: writing {}: {e}", path.display());
+                    std::process::exit(1);
+                }
+            }
+        }
     }
 
     /// The accuracy-and-cost summary printed by the examples.
