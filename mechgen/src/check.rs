@@ -431,11 +431,12 @@ impl Checker {
                     driver.name.span(),
                     format!(
                         "too many drivers: `{}` has {dof} degree{} of freedom but {drivers} \
-                         driver{} ({count}); remove {extra} driver{}",
+                         driver{} ({count}); remove {extra} driver{}, such as `{}`",
                         spec.name,
                         plural(dof),
                         plural(drivers),
                         plural(extra),
+                        driver.name,
                     ),
                 );
             }

@@ -21,7 +21,8 @@ use crate::stats::OpCounts;
 /// Choices that shape the generated code without changing its meaning.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CodegenOptions {
-    /// Largest number of operations (DAG nodes) one generated function body may hold; longer
+    /// Largest number of operations (DAG nodes plus output stores) one generated function body
+    /// may hold; longer
     /// bodies are split into helper functions of about this size. rustc's compile time grows
     /// much faster than linearly in the size of one function, so huge scenes need this.
     pub max_function_size: usize,
@@ -558,8 +559,9 @@ impl Context<'_> {
         }
     }
 
-    /// Non-zero `outputs`, in order, grouped so that the DAG each group evaluates has at most
-    /// `max_function_size` nodes (an output larger than that on its own is a group by itself).
+    /// Non-zero `outputs`, in order, grouped so that each group's DAG nodes plus its output
+    /// stores number at most `max_function_size` (an output larger than that on its own is a
+    /// group by itself).
     fn partition(&self, outputs: &[(TokenStream, Id)]) -> Vec<Vec<(TokenStream, Id)>> {
         let arena = self.arena();
         let max = self.options.max_function_size.max(1);
@@ -569,8 +571,10 @@ impl Context<'_> {
         let mut size = 0;
         let mut fresh = Vec::new();
         for (target, id) in outputs.iter().filter(|(_, id)| !arena.is_zero(*id)) {
+            // Each output is a store as well as the nodes it needs: a part of thousands of
+            // stores of shared constants is still a big function for rustc.
             new_nodes(arena, *id, &group_of, groups.len(), &mut fresh);
-            if size + fresh.len() > max && !groups.last().is_some_and(Vec::is_empty) {
+            if size + fresh.len() + 1 > max && !groups.last().is_some_and(Vec::is_empty) {
                 groups.push(Vec::new());
                 size = 0;
                 new_nodes(arena, *id, &group_of, groups.len(), &mut fresh);
@@ -578,7 +582,7 @@ impl Context<'_> {
             for node in &fresh {
                 group_of[node.index()] = groups.len();
             }
-            size += fresh.len();
+            size += fresh.len() + 1;
             if let Some(group) = groups.last_mut() {
                 group.push((target.clone(), *id));
             }

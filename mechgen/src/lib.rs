@@ -12,6 +12,7 @@
 //! documented in [`parse`].
 #![deny(missing_docs)]
 
+pub mod builder;
 pub mod check;
 pub mod diff;
 pub mod emit;
