@@ -21,7 +21,8 @@ use mechgen_runtime::{Matrix, Mechanism, Simulation, Solver, Storage, Vector};
 /// The seed generated naively (no folding, no simplification, no shared sub-expressions) by
 /// the package's `build.rs`: the baseline the lean code is timed against. Bench-only, so the
 /// examples do not pay for compiling it.
-#[allow(missing_docs, dead_code)]
+// Deliberately unsimplified code (`0.0 - 0.0`, `x * 1.0`, …): lints about it are the point.
+#[allow(missing_docs, dead_code, clippy::all)]
 mod naive {
     include!(concat!(env!("OUT_DIR"), "/piston_crank_naive.rs"));
 }

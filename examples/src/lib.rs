@@ -6,4 +6,5 @@ pub mod accuracy;
 pub mod closed_form;
 pub mod demo;
 pub mod plot;
+pub mod report;
 pub mod scenes;
