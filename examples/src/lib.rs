@@ -1,6 +1,7 @@
-//! Example scenes for mechgen: the seed piston-crank and a crank-rocker four-bar, declared with
-//! `mechanism!`, with their closed-form solutions (the accuracy reference of every test) and the
-//! plotting used by the example binaries.
+//! Example scenes for mechgen (the seed piston-crank, a crank-rocker four-bar and a
+//! positions-only offset slider), declared with `mechanism!`, with their closed-form solutions
+//! (the accuracy reference of every test), the plotting and driver code of the example binaries,
+//! and the accuracy-against-run-time report (`report`).
 
 pub mod accuracy;
 pub mod closed_form;
