@@ -87,15 +87,15 @@ const Y_AXIS_W: u32 = 96;
 /// Internal supersampling factor. plotters rounds every coordinate to an integer pixel, which makes
 /// curves visibly jagged at 900 px; drawing at twice the size and declaring the nominal size on the
 /// `<svg>` element (the `viewBox` keeps the doubled coordinates) halves that quantisation.
-const RES: u32 = 2;
+pub(crate) const RES: u32 = 2;
 
 /// A nominal length (px or font size) in internal drawing units.
-const fn px(v: u32) -> i32 {
+pub(crate) const fn px(v: u32) -> i32 {
     (v * RES) as i32
 }
 
 /// Colour-blind-friendly categorical palette (Tableau 10 order), so multi-series panels stay readable.
-const PALETTE: [RGBColor; 6] = [
+pub(crate) const PALETTE: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),

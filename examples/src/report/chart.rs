@@ -7,6 +7,7 @@
 //! [`ERROR_FLOOR`] (an exact result) are drawn at the floor, and empty inputs still give a valid
 //! SVG.
 
+use crate::plot::{PALETTE, RES, px};
 use std::ops::Range;
 
 use plotters::coord::Shift;
@@ -24,23 +25,6 @@ const WIDTH: u32 = 980;
 const HEIGHT: u32 = 620;
 /// Width of the legend column right of the plot, px.
 const LEGEND_W: u32 = 290;
-/// Drawn at twice the nominal size (see `plot.rs`: halves plotters' pixel rounding).
-const RES: u32 = 2;
-
-const fn px(v: u32) -> i32 {
-    (v * RES) as i32
-}
-
-/// Colour-blind-friendly palette (Tableau 10 order, as `plot.rs`).
-const PALETTE: [RGBColor; 6] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-];
-
 /// Marker shape of a curve's points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Marker {
