@@ -1,6 +1,6 @@
 //! `mechgen check`: a readable summary of a compiled scene (coordinates, equations, degrees of
-//! freedom, Jacobian sparsity, parameters) and, with `--stats`, the operation counts of the
-//! generated functions.
+//! freedom, Jacobian sparsity, length scale, parameters, branch invariants) and, with `--stats`,
+//! the operation counts of the generated functions.
 
 use core::fmt::{self, Write};
 
@@ -78,6 +78,27 @@ fn write_report(out: &mut String, scene: &Scene, file: &str, stats: bool) -> fmt
         "Jacobian Φ_q: {nonzeros} structural non-zeros of {total} ({n} × {n}), {percent:.1}% dense"
     )?;
 
+    let env = mechgen::interpret::Env {
+        params: model.params.iter().map(|p| p.default).collect(),
+        ..Default::default()
+    };
+    let scale = &scene.kinematics.length_scale;
+    let dependent: Vec<f64> = scale
+        .dependent
+        .iter()
+        .map(|&id| mechgen::interpret::eval(&model.arena, id, &env))
+        .collect();
+    writeln!(
+        out,
+        "length scale: {} (largest geometric length{})",
+        scale.evaluate(&dependent),
+        if dependent.is_empty() {
+            ""
+        } else {
+            ", with the parameters' defaults"
+        }
+    )?;
+
     if model.params.is_empty() {
         writeln!(out, "\nparameters: none")?;
     } else {
@@ -86,6 +107,13 @@ fn write_report(out: &mut String, scene: &Scene, file: &str, stats: bool) -> fmt
         for p in &model.params {
             let name = p.name.to_string();
             writeln!(out, "  {name:<w$} = {}", p.default, w = width.unwrap_or(0))?;
+        }
+    }
+
+    if !model.branches.is_empty() {
+        writeln!(out, "\nbranch invariants ({}):", model.branches.len())?;
+        for b in &model.branches {
+            writeln!(out, "  {}: {}", b.name, model.describe_branch(b))?;
         }
     }
 
@@ -124,6 +152,7 @@ mod tests {
         body rod near (1, 0, 0);
         joint pivot: revolute(frame, rod @ (-l, 0));
         driver swing: angle(rod) = sin(t);
+        branch hanging: cross(frame -> rod @ (-l, 0), rod -> rod @ (1, 0)) < 0;
     }";
 
     #[test]
@@ -138,6 +167,16 @@ mod tests {
         );
         assert!(text.contains("matched by 1 driver\n"), "{text}");
         assert!(text.contains("  l = 2\n"), "{text}");
+        assert!(
+            text.contains("length scale: 2 (largest geometric length, with the parameters'"),
+            "{text}"
+        );
+        assert!(
+            text.contains(
+                "branch invariants (1):\n  hanging: cross(frame -> rod @ (…), rod -> rod @ (1, 0)) < 0\n"
+            ),
+            "{text}"
+        );
         assert!(text.contains("function"), "{text}");
 
         let counts = mechgen::stats::function_counts(&scene);

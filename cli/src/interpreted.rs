@@ -8,10 +8,11 @@ use std::cell::RefCell;
 
 use mechgen::Scene;
 use mechgen::interpret::{Inputs, Tape};
+use mechgen::kinematics::LengthScale;
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{
-    Accelerations, Lu, Matrix, Mechanism, Outputs, ParameterError, SolveError, Vector, Velocities,
-    solve_accelerations, solve_velocities,
+    Accelerations, Lu, Matrix, Mechanism, Outputs, ParameterError, SolveError, Unit, Vector,
+    Velocities, solve_accelerations, solve_velocities,
 };
 
 /// A scene whose kinematics are interpreted rather than generated.
@@ -32,6 +33,14 @@ pub struct Interpreted {
     outputs: Outputs,
     /// Structural non-zeros of Φ_q, in the order the Jacobian tape produces them.
     pattern: Vec<(usize, usize)>,
+    coordinate_units: Vec<Unit>,
+    equation_units: Vec<Unit>,
+    /// The folded constant lengths, and a tape of the parameter-dependent ones.
+    length_scale: LengthScale,
+    lengths: Tape,
+    branch_names: Vec<String>,
+    /// One tape per branch invariant (its signed value).
+    branches: Vec<Tape>,
     /// Tape slots and output values, reused by every call (evaluation is `&self`).
     scratch: RefCell<Scratch>,
 }
@@ -62,14 +71,26 @@ impl Interpreted {
         ];
         let nu = kin.nu.as_deref().map(|nu| Tape::new(arena, nu));
         let gamma = kin.gamma.as_deref().map(|gamma| Tape::new(arena, gamma));
+        let lengths = Tape::new(arena, &kin.length_scale.dependent);
+        let branches: Vec<Tape> = kin
+            .branches
+            .iter()
+            .map(|&b| Tape::new(arena, &[b]))
+            .collect();
         let slots = tapes
             .iter()
             .chain(&nu)
             .chain(&gamma)
+            .chain([&lengths])
+            .chain(&branches)
             .map(Tape::len)
             .max()
             .unwrap_or(0);
-        let values = both.len().max(model.dim());
+        let values = both
+            .len()
+            .max(model.dim())
+            .max(kin.length_scale.dependent.len())
+            .max(1);
         let [guess, phi, jacobian, phi_and_jacobian] = tapes;
         let outputs = match model.outputs {
             mechgen::model::Outputs::Positions => Outputs::Positions,
@@ -90,6 +111,12 @@ impl Interpreted {
             gamma,
             outputs,
             pattern: kin.jacobian.iter().map(|e| (e.row, e.col)).collect(),
+            coordinate_units: model.coordinate_units().into_iter().map(unit).collect(),
+            equation_units: model.equation_units().into_iter().map(unit).collect(),
+            length_scale: kin.length_scale.clone(),
+            lengths,
+            branch_names: model.branches.iter().map(|b| b.name.clone()).collect(),
+            branches,
             scratch: RefCell::new(Scratch {
                 slots: vec![0.0; slots],
                 values: vec![0.0; values],
@@ -142,6 +169,14 @@ impl Interpreted {
     }
 }
 
+fn unit(unit: mechgen::model::Unit) -> Unit {
+    match unit {
+        mechgen::model::Unit::Angle => Unit::Angle,
+        mechgen::model::Unit::Length => Unit::Length,
+        mechgen::model::Unit::Area => Unit::Area,
+    }
+}
+
 fn copy_into(values: &[f64], out: &mut Vector<Dyn>) {
     for (o, v) in out.iter_mut().zip(values) {
         *o = *v;
@@ -186,6 +221,48 @@ impl Mechanism for Interpreted {
             .ok_or(ParameterError::Unknown)?;
         self.params[index] = value;
         Ok(())
+    }
+
+    fn coordinate_unit(&self, index: usize) -> Unit {
+        self.coordinate_units
+            .get(index)
+            .copied()
+            .unwrap_or(Unit::Angle)
+    }
+
+    fn equation_unit(&self, index: usize) -> Unit {
+        self.equation_units
+            .get(index)
+            .copied()
+            .unwrap_or(Unit::Angle)
+    }
+
+    fn length_scale(&self) -> f64 {
+        let count = self.length_scale.dependent.len();
+        let mut scale = self.length_scale.constant;
+        self.run(&self.lengths, self.inputs(&[], &[], 0.0), |v| {
+            scale = self.length_scale.evaluate(&v[..count.min(v.len())]);
+        });
+        scale
+    }
+
+    fn branch_count(&self) -> usize {
+        self.branches.len()
+    }
+
+    fn branch_name(&self, index: usize) -> Option<&str> {
+        self.branch_names.get(index).map(String::as_str)
+    }
+
+    fn branch_value(&self, index: usize, q: &Vector<Dyn>) -> f64 {
+        let Some(tape) = self.branches.get(index) else {
+            return f64::NAN;
+        };
+        let mut value = f64::NAN;
+        self.run(tape, self.inputs(q.as_slice(), &[], 0.0), |v| {
+            value = v.first().copied().unwrap_or(f64::NAN);
+        });
+        value
     }
 
     fn initial_guess(&self, q: &mut Vector<Dyn>) {

@@ -106,6 +106,14 @@ fn assembly_hint(error: &SolveError) -> &'static str {
             "the named equation is redundant or conflicts with others at this pose: check the \
              joints, or move the `near` guesses away from a dead-centre position"
         }
+        SolveError::NoAssembly { .. } => {
+            "the joints cannot all close with these dimensions: check the lengths, the \
+             parameters and the drivers' values at the start time"
+        }
+        SolveError::BranchFlip { .. } => {
+            "the guesses lead to another assembly branch than the scene's `branch` declares: \
+             move the `near` guesses towards the declared branch"
+        }
         _ => "check the parameter values and the `near` guesses for divisions by zero",
     }
 }
@@ -119,6 +127,14 @@ fn step_hint(error: &SolveError) -> &'static str {
         SolveError::Singular { .. } => {
             "the mechanism reaches a singular position (dead centre or a locked joint): check \
              the dimensions, or end the run before this time"
+        }
+        SolveError::NoAssembly { .. } => {
+            "the mechanism cannot close here (a driver beyond the reachable range?): check the \
+             dimensions and the drivers, or end the run before this time"
+        }
+        SolveError::BranchFlip { .. } => {
+            "the motion would leave the declared assembly branch (through a singular position, \
+             or the steps are too coarse even after sub-stepping): try more `--steps`"
         }
         _ => "a value became NaN or infinite: check the parameter values and the time range",
     }

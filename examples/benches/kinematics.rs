@@ -7,6 +7,9 @@
 //! reference setting (its tolerance and steps per revolution), so the report's per-call and
 //! per-step figures can be checked against these (the report prints criterion's beside its own).
 //!
+//! The group `seed/safeguards` times a seed step with the stability safeguards (unit scaling,
+//! condition estimate) on and off.
+//!
 //! `cargo bench -p mechgen-examples --bench kinematics`
 
 use std::hint::black_box;
@@ -16,7 +19,7 @@ use mechgen_cli::Interpreted;
 use mechgen_examples::report::{AutoDiff, CentralDifference, ForwardDifference, Plan};
 use mechgen_examples::scenes::{FourBar, PistonCrank};
 use mechgen_runtime::nalgebra::DefaultAllocator;
-use mechgen_runtime::{Matrix, Mechanism, Simulation, Solver, Storage, Vector};
+use mechgen_runtime::{Matrix, Mechanism, Simulation, Solver, SolverOptions, Storage, Vector};
 
 /// The seed generated naively (no folding, no simplification, no shared sub-expressions) by
 /// the package's `build.rs`: the baseline the lean code is timed against. Bench-only, so the
@@ -82,6 +85,40 @@ where
     group.finish();
 }
 
+/// What the stability safeguards cost per seed step, measured in one group: unit scaling and the
+/// condition estimate, each switched off alone and together (the line search and the
+/// Levenberg–Marquardt fallback cost nothing until a step fails).
+fn safeguards(c: &mut Criterion) {
+    let seed = PistonCrank::default();
+    let period = 2.0 * std::f64::consts::PI / seed.omega;
+    let reference = Plan::full().reference;
+    let h = period / reference.steps as f64;
+    let mut group = c.benchmark_group("seed/safeguards");
+    for (label, scale_units, estimate_condition) in [
+        ("scaling+condition", true, true),
+        ("scaling", true, false),
+        ("condition", false, true),
+        ("neither", false, false),
+    ] {
+        let options = SolverOptions {
+            scale_units,
+            estimate_condition,
+            ..reference.options()
+        };
+        let mut simulation =
+            Simulation::new(Solver::with_options(seed, options), 0.0).expect("scene assembles");
+        let mut time = 0.0;
+        group.bench_function(label, |b| {
+            b.iter(|| {
+                time += h;
+                let state = simulation.step_to(black_box(time)).expect("steps");
+                black_box(state.q[0]);
+            });
+        });
+    }
+    group.finish();
+}
+
 fn kinematics(c: &mut Criterion) {
     let seed_period = 2.0 * std::f64::consts::PI / PistonCrank::default().omega;
     bench_scene(c, "seed/generated", PistonCrank::default(), seed_period);
@@ -140,6 +177,6 @@ criterion_group! {
     config = Criterion::default()
         .warm_up_time(std::time::Duration::from_millis(500))
         .measurement_time(std::time::Duration::from_secs(2));
-    targets = kinematics
+    targets = safeguards, kinematics
 }
 criterion_main!(benches);

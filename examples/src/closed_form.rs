@@ -26,7 +26,10 @@ pub struct Kinematics<const N: usize> {
 
 /// Evaluates a position function generic over dual numbers at `t` with a second-order dual number,
 /// splitting the result into `q`, `q̇`, `q̈`.
-fn differentiate<const N: usize>(f: impl Fn(Dual2_64) -> [Dual2_64; N], t: f64) -> Kinematics<N> {
+pub fn differentiate<const N: usize>(
+    f: impl Fn(Dual2_64) -> [Dual2_64; N],
+    t: f64,
+) -> Kinematics<N> {
     let parts: [(f64, f64, f64); N] = second_derivative(f, t);
     Kinematics {
         t,
@@ -114,6 +117,11 @@ impl PistonCrank {
     ///
     /// Branch: the piston pin lies on the +X side of the crank pin (the assembled seed configuration).
     pub fn positions_generic<D: DualNum<Primitive = f64> + Copy>(&self, t: D) -> [D; 15] {
+        self.positions_at_angle(t * self.omega)
+    }
+
+    /// Positions with the crank at angle `th_d` (any drive law: pass `θ(t)` as a dual number).
+    pub fn positions_at_angle<D: DualNum<Primitive = f64> + Copy>(&self, th_d: D) -> [D; 15] {
         let s = self.scale;
         let r = self.crank_radius * s;
         let e = self.rod_crank_pin * s; // rod: crank pin at (e, 0)
@@ -121,7 +129,6 @@ impl PistonCrank {
         let p = self.piston_pin * s;
         let zero = D::from(0.0);
 
-        let th_d = t * self.omega;
         let (sin_d, cos_d) = th_d.sin_cos();
         // Crank pin: crank@(0, r) rotated by the crank angle about the bearing at the origin.
         let px = sin_d * (-r);
@@ -179,6 +186,50 @@ impl PistonCrank {
     }
 
     /// Time of one crank revolution, `2π/ω`, s.
+    pub fn period(&self) -> f64 {
+        core::f64::consts::TAU / self.omega
+    }
+}
+
+/// An in-line slider-crank with its reference points at the joints, for toggle-position tests.
+///
+/// Bodies, in coordinate order: frame (ground at the origin), crank (reference point at the
+/// pivot), rod (reference point at the crank pin, slider pin at rod@`(l, 0)`), slider (on the
+/// frame's x axis, not rotating). Driver `θ_crank = ω t`. Branch: the slider ahead of the crank
+/// pin, `x_slider > x_pin`. With `l > r` the crank turns fully; with `l = r` the rod folds onto
+/// the crank at `θ = π/2` (a toggle position, where Φ_q is singular).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SliderCrank {
+    /// Crank radius r.
+    pub crank: f64,
+    /// Rod length l.
+    pub rod: f64,
+    /// Crank speed ω, rad/s.
+    pub omega: f64,
+}
+
+impl SliderCrank {
+    /// Positions with the crank at angle `theta`.
+    pub fn positions_at_angle<D: DualNum<Primitive = f64> + Copy>(&self, theta: D) -> [D; 12] {
+        let (r, l) = (self.crank, self.rod);
+        let zero = D::from(0.0);
+        let (sin, cos) = theta.sin_cos();
+        let (px, py) = (cos * r, sin * r);
+        // l² − (r sin θ)² written as (l − r sin θ)(l + r sin θ): no cancellation near the toggle.
+        let reach = ((-(py) + l) * (py + l)).sqrt();
+        let x = px + reach;
+        let phi = (-py).atan2(reach);
+        [
+            zero, zero, zero, zero, zero, theta, px, py, phi, x, zero, zero,
+        ]
+    }
+
+    /// Exact `q`, `q̇`, `q̈` at time `t`.
+    pub fn kinematics(&self, t: f64) -> Kinematics<12> {
+        differentiate(|t| self.positions_at_angle(t * self.omega), t)
+    }
+
+    /// Time of one crank revolution, `2π/ω`.
     pub fn period(&self) -> f64 {
         core::f64::consts::TAU / self.omega
     }

@@ -9,3 +9,4 @@ pub mod demo;
 pub mod plot;
 pub mod report;
 pub mod scenes;
+pub mod stability;

@@ -28,6 +28,10 @@ mechanism! {
         joint slide: prismatic(liner, piston, along (1, 0));
 
         driver crank_angle: angle(crank) = omega * t;
+
+        /// The piston stays on the liner's side of the crank pin: the rod, from crank pin to piston
+        /// pin, points along the cylinder axis (bearing to liner).
+        branch piston_outboard: dot(bearing -> liner, rod @ (41.3, 0) -> rod @ (0, 102.6)) > 0;
     }
 }
 
@@ -55,6 +59,10 @@ mechanism! {
         joint rocker_pivot: revolute(rocker, frame @ (100, 0));
 
         driver crank_angle: angle(crank) = omega * t;
+
+        /// Open, not crossed: at the rocker pin, the rocker (towards its pivot) lies anticlockwise of
+        /// the coupler (towards the crank pin).
+        branch open_assembly: cross(coupler @ (120, 0) -> coupler, rocker @ (80, 0) -> rocker) > 0;
     }
 }
 

@@ -44,6 +44,7 @@ use proc_macro2::{Delimiter, Spacing, Span, TokenStream, TokenTree};
 use crate::emit::CodegenOptions;
 use crate::error::Errors;
 use crate::model::Outputs;
+pub use crate::spec::{Product, Sign};
 
 /// A scalar of the spec: a number, or an expression in parameters (and `t` in drivers) written
 /// in the grammar's syntax, e.g. `"omega * t"` or `"0.5 * sin(2 * t)"`.
@@ -328,6 +329,43 @@ impl SceneBuilder {
         let what = format!("driver `{name}`");
         self.check_name(joint, &format!("the joint of {what}"));
         self.driver(name, format!("travel({joint})"), value)
+    }
+
+    /// `branch NAME: cross(u.0 -> u.1, v.0 -> v.1) > 0;` (or `dot(…)`, or `< 0`): a branch
+    /// invariant, the product of two world vectors between body-fixed points whose sign the
+    /// solver keeps (see [`crate::parse`]).
+    ///
+    /// ```
+    /// # use mechgen::builder::{Product, SceneBuilder, Sign};
+    /// # let mut scene = SceneBuilder::new("FourBar");
+    /// scene.branch(
+    ///     "open",
+    ///     Product::Cross,
+    ///     (("coupler", [120.0, 0.0]), "coupler"),
+    ///     (("rocker", [80.0, 0.0]), "rocker"),
+    ///     Sign::Positive,
+    /// );
+    /// ```
+    pub fn branch(
+        &mut self,
+        name: &str,
+        product: Product,
+        u: (impl Into<Point>, impl Into<Point>),
+        v: (impl Into<Point>, impl Into<Point>),
+        sign: Sign,
+    ) -> &mut Self {
+        let what = format!("branch `{name}`");
+        self.check_name(name, &what);
+        let [u0, u1, v0, v1] =
+            [u.0.into(), u.1.into(), v.0.into(), v.1.into()].map(|p| self.point(p, &what));
+        let comparison = match sign {
+            Sign::Positive => ">",
+            Sign::Negative => "<",
+        };
+        self.push(format!(
+            "branch {name}: {}({u0} -> {u1}, {v0} -> {v1}) {comparison} 0;",
+            product.name()
+        ))
     }
 
     /// The scene as spec text (the grammar of [`crate::parse`]), ready for
@@ -700,6 +738,52 @@ mod tests {
             .unwrap_or_else(|e| panic!("{e}"))
             .to_string();
         assert!(code.contains("struct SliderCrank"));
+    }
+
+    #[test]
+    fn branches_are_written_in_the_grammar() {
+        let mut scene = slider_crank();
+        scene
+            .branch(
+                "outboard",
+                Product::Dot,
+                ("frame", "slider"),
+                (("rod", [-1.0, 0.0]), ("rod", [1.0, 0.0])),
+                Sign::Positive,
+            )
+            .item_doc("The slider stays right of the crank.")
+            .branch(
+                "up",
+                Product::Cross,
+                ("frame", ("crank", [0.5, 0.0])),
+                ("frame", "slider"),
+                Sign::Negative,
+            );
+        let text = scene.build().unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            text.contains(
+                "    /// The slider stays right of the crank.\n    branch outboard: \
+                 dot(frame -> slider, rod @ (-1.0, 0.0) -> rod @ (1.0, 0.0)) > 0;"
+            ),
+            "{text}"
+        );
+        assert!(
+            text.contains("branch up: cross(frame -> crank @ (0.5, 0.0), frame -> slider) < 0;"),
+            "{text}"
+        );
+        let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        assert_eq!(compiled.model.branches.len(), 2);
+        assert_eq!(compiled.kinematics.branches.len(), 2);
+        let mut bad = slider_crank();
+        bad.branch(
+            "t",
+            Product::Dot,
+            ("frame", "b-c"),
+            ("frame", "slider"),
+            Sign::Positive,
+        );
+        let messages = bad.build().expect_err("errors").messages();
+        assert_eq!(messages.len(), 2, "{messages:#?}");
     }
 
     #[test]

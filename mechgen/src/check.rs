@@ -11,15 +11,18 @@ use syn::Ident;
 
 use crate::error::Errors;
 use crate::expr::{Arena, Func, Id, Node, Var};
-use crate::model::{Body, Constraint, ConstraintKind, Driven, Model, Outputs, Param, Point};
-use crate::spec::{BinOp, DriverKind, Expr, ExprKind, JointKind, PointRef, Spec};
+use crate::model::{
+    Body, Branch, Constraint, ConstraintKind, Driven, Model, Outputs, Param, Point,
+};
+use crate::spec::{BinOp, BranchDecl, DriverKind, Expr, ExprKind, JointKind, PointRef, Spec};
 
 /// Checks a spec and builds its model.
 ///
 /// # Errors
 /// Every problem found, each at its span: unknown or duplicate names, joints from a body to
 /// itself or between two ground bodies, drivers on ground bodies, zero axes or distances,
-/// `t` outside drivers, unknown functions, and drivers not matching the degrees of freedom.
+/// `t` outside drivers, unknown functions, malformed branch invariants, drivers not matching
+/// the degrees of freedom, and structurally redundant constraints (see [`Structure`]).
 pub fn check(spec: &Spec) -> Result<Model, Errors> {
     check_into(spec, Arena::new())
 }
@@ -92,22 +95,31 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
             });
         }
     }
+    let branches: Vec<Branch> = spec
+        .branches
+        .iter()
+        .filter_map(|decl| cx.branch(decl))
+        .collect();
     // A rejected joint or driver would make the degree-of-freedom count misleading: count only a
     // scene whose parts all checked.
-    if cx.errors.is_empty() {
-        cx.check_mobility(spec);
-    }
-    cx.errors.finish()?;
-    Ok(Model {
+    let count = cx.errors.is_empty();
+    let mut model = Model {
         docs: spec.docs.clone(),
         vis: spec.vis.clone(),
         name: spec.name.clone(),
-        arena: cx.arena,
+        arena: std::mem::take(&mut cx.arena),
         params,
         bodies,
         constraints,
+        branches,
         outputs,
-    })
+    };
+    if count {
+        let structure = Structure::of_model(&mut model);
+        cx.check_mobility(spec, &model, &structure);
+    }
+    cx.errors.finish()?;
+    Ok(model)
 }
 
 struct Checker {
@@ -121,8 +133,9 @@ struct Checker {
 }
 
 impl Checker {
-    /// Every declared name is unique across parameters, bodies, joints and drivers (they share
-    /// the generated namespace: fields, accessors, equation names); `t` is reserved.
+    /// Every declared name is unique across parameters, bodies, joints, drivers and branches
+    /// (they share the generated namespace: fields, accessors, equation and branch names); `t` is
+    /// reserved.
     fn check_names(&mut self, spec: &Spec) {
         let mut seen: HashMap<String, &str> = HashMap::new();
         let names = spec
@@ -131,7 +144,8 @@ impl Checker {
             .map(|p| (&p.name, "parameter"))
             .chain(spec.bodies.iter().map(|b| (&b.name, "body")))
             .chain(spec.joints.iter().map(|j| (&j.name, "joint")))
-            .chain(spec.drivers.iter().map(|d| (&d.name, "driver")));
+            .chain(spec.drivers.iter().map(|d| (&d.name, "driver")))
+            .chain(spec.branches.iter().map(|b| (&b.name, "branch")));
         for (name, what) in names {
             let key = name.to_string();
             if key == "t" {
@@ -146,7 +160,7 @@ impl Checker {
                     name.span(),
                     format!(
                         "duplicate name `{key}`: a {first} of that name is declared above; \
-                         every parameter, body, joint and driver needs its own name"
+                         every parameter, body, joint, driver and branch needs its own name"
                     ),
                 );
             } else {
@@ -373,10 +387,79 @@ impl Checker {
         }
     }
 
+    /// A branch invariant: known bodies, points without `t`, the literal 0 on the right, no
+    /// vector from a point to itself, and at least one vector that can turn.
+    fn branch(&mut self, decl: &BranchDecl) -> Option<Branch> {
+        if !matches!(decl.zero.kind, ExprKind::Number(v) if v == 0.0) {
+            self.errors.push(
+                decl.zero.span,
+                format!(
+                    "compare the branch invariant with `0`: only its sign tells the branches \
+                     apart; write `{}(…) > 0` or `{}(…) < 0`",
+                    decl.product.name(),
+                    decl.product.name()
+                ),
+            );
+        }
+        let [u0, u1, v0, v1] =
+            [&decl.u[0], &decl.u[1], &decl.v[0], &decl.v[1]].map(|p| self.point(p));
+        let (u, v) = ([u0?, u1?], [v0?, v1?]);
+        let mut valid = true;
+        for (points, refs) in [(u, &decl.u), (v, &decl.v)] {
+            if self.same_point(points[0], points[1]) {
+                self.errors.push(
+                    refs[1].body.span(),
+                    format!(
+                        "this vector goes from a point of `{}` to the same point, so it has no \
+                         direction; give two different points",
+                        refs[0].body
+                    ),
+                );
+                valid = false;
+            }
+        }
+        let fixed = |points: [Point; 2]| points.iter().all(|p| self.ground[p.body]);
+        if valid && fixed(u) && fixed(v) {
+            self.errors.push(
+                decl.product_span,
+                "both vectors join points of ground bodies, so this invariant never changes; \
+                 use points on moving bodies",
+            );
+            valid = false;
+        }
+        valid.then(|| Branch {
+            name: decl.name.to_string(),
+            docs: decl.docs.clone(),
+            product: decl.product,
+            u,
+            v,
+            sign: decl.sign,
+        })
+    }
+
+    /// True if two points are structurally the same: one body, equal body-frame coordinates
+    /// (the same node, or the same constant in an arena that does not fold).
+    fn same_point(&self, a: Point, b: Point) -> bool {
+        let constant = |id: Id| {
+            let arena = &self.arena;
+            arena.as_const(id).or_else(|| {
+                (!arena.any_node(id, |n| matches!(n, Node::Var(_) | Node::Param(_))))
+                    .then(|| crate::interpret::eval(arena, id, &crate::interpret::Env::default()))
+            })
+        };
+        a.body == b.body
+            && (0..2).all(|k| {
+                a.local[k] == b.local[k]
+                    || matches!((constant(a.local[k]), constant(b.local[k])), (Some(x), Some(y)) if x == y)
+            })
+    }
+
     /// Gruebler count: each moving body has 3 coordinates, each joint removes its equations
     /// (ground bodies bring 3 coordinates and 3 equations, which cancel); drivers must take up
-    /// exactly the rest so that the system is square.
-    fn check_mobility(&mut self, spec: &Spec) {
+    /// exactly the rest so that the system is square. A square system must then also be
+    /// structurally non-singular ([`Structure`]): no group of constraints may over-determine
+    /// some bodies while others keep free coordinates.
+    fn check_mobility(&mut self, spec: &Spec, model: &Model, structure: &Structure) {
         let moving = spec.bodies.iter().filter(|b| !b.ground).count();
         let joint_equations: usize = spec
             .joints
@@ -399,11 +482,21 @@ impl Checker {
             },
         );
         if dof < 0 {
+            let part = if structure.over_equations.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "; {} over-determine {} ({})",
+                    structure.statements(model),
+                    structure.over_bodies(model),
+                    structure.over_count(),
+                )
+            };
             self.errors.push(
                 spec.name.span(),
                 format!(
-                    "the joints over-constrain the mechanism ({count}); remove joints or add \
-                     bodies"
+                    "the joints over-constrain the mechanism ({count}){part}; remove joints or \
+                     add bodies"
                 ),
             );
         } else if drivers < dof {
@@ -439,6 +532,44 @@ impl Checker {
                         driver.name,
                     ),
                 );
+            }
+        } else if !structure.over_equations.is_empty() {
+            let free: Vec<String> = structure
+                .under_free
+                .iter()
+                .map(|&c| format!("`{}`", coordinate_name(model, c)))
+                .collect();
+            let under = structure.under_bodies(model);
+            let message = format!(
+                "structurally redundant constraints: {} over-determine {} ({}) while {} keep{} \
+                 {} coordinate{} free ({}), so the Jacobian is singular in every position \
+                 although the Gruebler count matches; remove one of these constraints and \
+                 constrain {} instead",
+                structure.statements(model),
+                structure.over_bodies(model),
+                structure.over_count(),
+                under,
+                if structure.under_body_count(model) == 1 {
+                    "s"
+                } else {
+                    ""
+                },
+                free.len(),
+                plural(free.len() as i64),
+                free.join(", "),
+                under,
+            );
+            let ground = model.bodies.iter().filter(|b| b.ground).count();
+            for &k in &structure.over_constraints(model) {
+                let span = match k.checked_sub(ground) {
+                    Some(j) if j < spec.joints.len() => spec.joints[j].name.span(),
+                    Some(j) => spec
+                        .drivers
+                        .get(j - spec.joints.len())
+                        .map_or(spec.name.span(), |d| d.name.span()),
+                    None => spec.name.span(),
+                };
+                self.errors.push(span, &message);
             }
         }
     }
@@ -570,6 +701,274 @@ impl Checker {
             }
         }
     }
+}
+
+/// The structure of the Jacobian's sparsity pattern: which coordinates each equation touches
+/// (ground bodies enter joints as constant poses, so only their own equations touch them), a
+/// maximum matching of equations to coordinates, and from it the coarse Dulmage–Mendelsohn
+/// decomposition.
+///
+/// A perfect matching means the Jacobian can be non-singular; otherwise it is singular at every
+/// position, whatever the dimensions. Equations reachable from an unmatched equation by
+/// alternating paths (equation → a coordinate it touches → the equation matched to that
+/// coordinate → …) form the *over-determined* part: more equations than the coordinates they
+/// touch. Coordinates reachable the same way from an unmatched coordinate form the
+/// *under-determined* part.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Structure {
+    /// Size of the maximum matching: the structural rank of Φ_q.
+    pub rank: usize,
+    /// Equations of the over-determined part, ascending.
+    pub over_equations: Vec<usize>,
+    /// Coordinates of the over-determined part, ascending.
+    pub over_coordinates: Vec<usize>,
+    /// Coordinates of the under-determined part, ascending.
+    pub under_coordinates: Vec<usize>,
+    /// The unmatched coordinates (free whatever the constraints do), ascending.
+    pub under_free: Vec<usize>,
+}
+
+const UNMATCHED: usize = usize::MAX;
+
+impl Structure {
+    /// The structure of a model's Φ: the equations are built into the model's arena (the same
+    /// hash-consed nodes `kinematics` derives from later) and each one's coordinates read off.
+    pub fn of_model(model: &mut Model) -> Self {
+        let phi = crate::kinematics::constraint_equations(model);
+        let rows: Vec<Vec<usize>> = phi
+            .iter()
+            .map(|&e| {
+                model
+                    .arena
+                    .variables(e)
+                    .into_iter()
+                    .filter_map(|v| match v {
+                        Var::Q(k) => Some(k as usize),
+                        _ => None,
+                    })
+                    .collect()
+            })
+            .collect();
+        Self::of_pattern(&rows, model.dim())
+    }
+
+    /// The structure of a pattern: `rows[i]` lists the coordinates (`< columns`) equation `i`
+    /// touches.
+    ///
+    /// Augmenting paths from a greedy start, each search a depth-first walk with a look-ahead
+    /// for a free coordinate and visit stamps: O(equations × non-zeros) at worst, near linear on
+    /// the chains and trees of real mechanisms.
+    pub fn of_pattern(rows: &[Vec<usize>], columns: usize) -> Self {
+        let mut row_match = vec![UNMATCHED; rows.len()];
+        let mut col_match = vec![UNMATCHED; columns];
+        for (r, cols) in rows.iter().enumerate() {
+            if let Some(&c) = cols.iter().find(|&&c| col_match[c] == UNMATCHED) {
+                row_match[r] = c;
+                col_match[c] = r;
+            }
+        }
+        let mut stamp = vec![0usize; columns];
+        let mut stack: Vec<(usize, usize)> = Vec::new();
+        for root in 0..rows.len() {
+            if row_match[root] != UNMATCHED {
+                continue;
+            }
+            let round = root + 1;
+            stack.clear();
+            stack.push((root, 0));
+            let mut found = None;
+            while let Some((row, next)) = stack.last_mut() {
+                let row = *row;
+                // Look-ahead: a free coordinate of this row ends the path at once.
+                if *next == 0
+                    && let Some(&c) = rows[row].iter().find(|&&c| col_match[c] == UNMATCHED)
+                {
+                    found = Some(c);
+                    break;
+                }
+                match rows[row].get(*next) {
+                    Some(&c) => {
+                        *next += 1;
+                        if stamp[c] != round {
+                            stamp[c] = round;
+                            stack.push((col_match[c], 0));
+                        }
+                    }
+                    None => {
+                        stack.pop();
+                    }
+                }
+            }
+            // Flip the path: the top row takes the free coordinate, every row below it the
+            // coordinate through which the walk left it.
+            if let Some(mut c) = found {
+                while let Some((row, _)) = stack.pop() {
+                    row_match[row] = c;
+                    col_match[c] = row;
+                    if let Some(&(below, next)) = stack.last() {
+                        c = rows[below][next - 1];
+                    }
+                }
+            }
+        }
+
+        let mut structure = Structure {
+            rank: row_match.iter().filter(|&&c| c != UNMATCHED).count(),
+            ..Structure::default()
+        };
+        // Over-determined: alternating walks from unmatched equations.
+        let mut seen_row = vec![false; rows.len()];
+        let mut seen_col = vec![false; columns];
+        let mut queue: Vec<usize> = (0..rows.len())
+            .filter(|&r| row_match[r] == UNMATCHED)
+            .collect();
+        for &r in &queue {
+            seen_row[r] = true;
+        }
+        while let Some(r) = queue.pop() {
+            for &c in &rows[r] {
+                if !std::mem::replace(&mut seen_col[c], true) {
+                    let next = col_match[c];
+                    if next != UNMATCHED && !std::mem::replace(&mut seen_row[next], true) {
+                        queue.push(next);
+                    }
+                }
+            }
+        }
+        structure.over_equations = (0..rows.len()).filter(|&r| seen_row[r]).collect();
+        structure.over_coordinates = (0..columns).filter(|&c| seen_col[c]).collect();
+        // Under-determined: alternating walks from unmatched coordinates.
+        let mut touching: Vec<Vec<usize>> = vec![Vec::new(); columns];
+        for (r, cols) in rows.iter().enumerate() {
+            for &c in cols {
+                touching[c].push(r);
+            }
+        }
+        let mut seen_row = vec![false; rows.len()];
+        let mut seen_col = vec![false; columns];
+        structure.under_free = (0..columns)
+            .filter(|&c| col_match[c] == UNMATCHED)
+            .collect();
+        let mut queue = structure.under_free.clone();
+        for &c in &queue {
+            seen_col[c] = true;
+        }
+        while let Some(c) = queue.pop() {
+            for &r in &touching[c] {
+                if !std::mem::replace(&mut seen_row[r], true) {
+                    let next = row_match[r];
+                    if next != UNMATCHED && !std::mem::replace(&mut seen_col[next], true) {
+                        queue.push(next);
+                    }
+                }
+            }
+        }
+        structure.under_coordinates = (0..columns).filter(|&c| seen_col[c]).collect();
+        structure
+    }
+
+    /// The constraints (indices into `model.constraints`) owning the over-determined equations.
+    fn over_constraints(&self, model: &Model) -> Vec<usize> {
+        let mut owner = Vec::with_capacity(model.dim());
+        for (k, c) in model.constraints.iter().enumerate() {
+            owner.extend(std::iter::repeat_n(k, c.kind.equation_suffixes().len()));
+        }
+        let mut constraints: Vec<usize> = self
+            .over_equations
+            .iter()
+            .filter_map(|&e| owner.get(e).copied())
+            .collect();
+        constraints.dedup();
+        constraints
+    }
+
+    /// "joints `a`, `b` and driver `d`": the over-determined part's statements.
+    fn statements(&self, model: &Model) -> String {
+        let mut groups: [(&str, Vec<String>); 3] = [
+            ("ground bod", Vec::new()),
+            ("joint", Vec::new()),
+            ("driver", Vec::new()),
+        ];
+        for k in self.over_constraints(model) {
+            let c = &model.constraints[k];
+            let group = match c.kind {
+                ConstraintKind::Ground { .. } => 0,
+                ConstraintKind::Driver { .. } => 2,
+                _ => 1,
+            };
+            groups[group].1.push(format!("`{}`", c.name));
+        }
+        let parts: Vec<String> = groups
+            .iter()
+            .filter(|(_, names)| !names.is_empty())
+            .map(|(what, names)| {
+                let what = match (*what, names.len()) {
+                    ("ground bod", 1) => "ground body".to_owned(),
+                    ("ground bod", _) => "ground bodies".to_owned(),
+                    (what, 1) => what.to_owned(),
+                    (what, _) => format!("{what}s"),
+                };
+                format!("{what} {}", names.join(", "))
+            })
+            .collect();
+        match parts.as_slice() {
+            [] => "no constraint".to_owned(),
+            [one] => one.clone(),
+            [init @ .., last] => format!("{} and {last}", init.join(", ")),
+        }
+    }
+
+    /// "(7 equations for 6 coordinates)"
+    fn over_count(&self) -> String {
+        format!(
+            "{} equation{} for {} coordinate{}",
+            self.over_equations.len(),
+            plural(self.over_equations.len() as i64),
+            self.over_coordinates.len(),
+            plural(self.over_coordinates.len() as i64),
+        )
+    }
+
+    fn over_bodies(&self, model: &Model) -> String {
+        bodies_of(model, &self.over_coordinates)
+    }
+
+    fn under_bodies(&self, model: &Model) -> String {
+        bodies_of(model, &self.under_coordinates)
+    }
+
+    fn under_body_count(&self, model: &Model) -> usize {
+        let mut bodies: Vec<usize> = self.under_coordinates.iter().map(|c| c / 3).collect();
+        bodies.dedup();
+        bodies.len().min(model.bodies.len())
+    }
+}
+
+/// "body `a`" or "bodies `a`, `b`": the bodies owning `coordinates` (ascending).
+fn bodies_of(model: &Model, coordinates: &[usize]) -> String {
+    let mut names: Vec<String> = Vec::new();
+    let mut last = None;
+    for &c in coordinates {
+        if last != Some(c / 3) {
+            last = Some(c / 3);
+            if let Some(body) = model.bodies.get(c / 3) {
+                names.push(format!("`{}`", body.name));
+            }
+        }
+    }
+    match names.len() {
+        0 => "no body".to_owned(),
+        1 => format!("body {}", names[0]),
+        _ => format!("bodies {}", names.join(", ")),
+    }
+}
+
+fn coordinate_name(model: &Model, coordinate: usize) -> String {
+    model
+        .coordinate_names()
+        .get(coordinate)
+        .cloned()
+        .unwrap_or_default()
 }
 
 fn plural(n: i64) -> &'static str {
@@ -709,5 +1108,93 @@ mod tests {
         let msgs = errors(&scene("driver d: travel(o) = t;")).join("\n");
         assert!(msgs.contains("not a prismatic joint"), "{msgs}");
         assert!(errors(&scene("driver d: travel(s) = 1 + t;")).is_empty());
+    }
+
+    #[test]
+    fn branch_invariants_check_their_parts() {
+        let ok = "branch out: dot(frame -> crank @ (1, 0), rod -> rod @ (2, 0)) > 0; \
+                  branch turn: cross(crank -> crank @ (1, 0), frame -> slider) < 0;";
+        let spec = parse_str(&scene(&format!("driver d: angle(crank) = w * t; {ok}")))
+            .unwrap_or_else(|e| panic!("parses: {e}"));
+        let model = check(&spec).unwrap_or_else(|e| panic!("checks: {e}"));
+        assert_eq!(model.branches.len(), 2);
+        assert_eq!(model.branches[1].sign, crate::model::Sign::Negative);
+
+        let msgs = errors(&scene(
+            "driver d: angle(crank) = w * t; \
+             branch a: cross(crnk -> rod, rod -> slider) > 0; \
+             branch b: dot(crank -> rod, rod -> slider) > 1; \
+             branch c: dot(crank @ (t, 0) -> rod, rod -> slider) > 0; \
+             branch d: dot(rod @ (1, 2) -> rod @ (1, 2), rod -> slider) > 0; \
+             branch e: cross(frame -> frame @ (1, 0), frame @ (0, 1) -> frame) > 0;",
+        ))
+        .join("\n");
+        assert!(
+            msgs.contains("unknown body `crnk`; did you mean `crank`?"),
+            "{msgs}"
+        );
+        assert!(
+            msgs.contains("compare the branch invariant with `0`"),
+            "{msgs}"
+        );
+        assert!(msgs.contains("time `t` can only appear"), "{msgs}");
+        assert!(msgs.contains("to the same point"), "{msgs}");
+        assert!(msgs.contains("never changes"), "{msgs}");
+        assert!(msgs.contains("duplicate name `d`"), "{msgs}");
+    }
+
+    #[test]
+    fn matching_finds_the_over_and_under_determined_parts() {
+        // Equations 0–2 touch coordinates 0 and 1 only; equation 3 touches 2 and 3.
+        let rows = [vec![0, 1], vec![0, 1], vec![1], vec![2, 3]];
+        let s = Structure::of_pattern(&rows, 4);
+        assert_eq!(s.rank, 3);
+        assert_eq!(s.over_equations, [0, 1, 2]);
+        assert_eq!(s.over_coordinates, [0, 1]);
+        assert_eq!(s.under_coordinates, [2, 3]);
+        assert_eq!(s.under_free.len(), 1);
+        // A chain needing an augmenting path through every earlier equation.
+        let n = 2000;
+        let mut rows: Vec<Vec<usize>> = (0..n - 1).map(|i| vec![i, i + 1]).collect();
+        rows.push(vec![0]);
+        let s = Structure::of_pattern(&rows, n);
+        assert_eq!(s.rank, n);
+        assert!(s.over_equations.is_empty() && s.under_coordinates.is_empty());
+    }
+
+    #[test]
+    fn structurally_redundant_joints_are_reported_though_gruebler_matches() {
+        // a and b are pinned together twice (and a to the ground), while c keeps its angle free:
+        // 12 coordinates, 12 equations, but a singular Jacobian.
+        let msgs = errors(
+            "mechanism M {
+                ground g at (0, 0, 0);
+                body a near (1, 0, 0);
+                body b near (2, 0, 0);
+                body c near (0, 1, 0);
+                joint pivot: revolute(g, a @ (-1, 0));
+                joint pin_1: revolute(a @ (1, 0), b @ (-1, 0));
+                joint pin_2: revolute(a @ (1, 1), b @ (-1, 1));
+                joint hinge: revolute(g, c);
+                driver spin: angle(a) = t;
+            }",
+        );
+        assert_eq!(msgs.len(), 4, "{msgs:#?}");
+        let expected = "structurally redundant constraints: joints `pivot`, `pin_1`, `pin_2` and \
+                        driver `spin` over-determine bodies `a`, `b` (7 equations for 6 \
+                        coordinates) while body `c` keeps 1 coordinate free (`c.theta`)";
+        for message in &msgs {
+            assert!(message.starts_with(expected), "{message}");
+        }
+        // The over-constrained pendulum names its joints.
+        let msgs = errors(
+            "mechanism P { ground f at (0, 0, 0); body bob near (1, 0, 0);
+               joint pivot: revolute(f, bob @ (-1, 0)); joint stop: revolute(f @ (1, 0), bob); }",
+        )
+        .join("\n");
+        assert!(
+            msgs.contains("joints `pivot`, `stop` over-determine body `bob` (4 equations for 3"),
+            "{msgs}"
+        );
     }
 }

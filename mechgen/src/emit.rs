@@ -15,7 +15,7 @@ use quote::{format_ident, quote};
 use crate::expr::{Arena, Func, Id, Node, Var};
 use crate::interpret::topological_order;
 use crate::kinematics::Kinematics;
-use crate::model::{COORDINATE_SUFFIXES, Model, Outputs};
+use crate::model::{COORDINATE_SUFFIXES, Model, Outputs, Unit};
 use crate::stats::OpCounts;
 
 /// Choices that shape the generated code without changing its meaning.
@@ -157,6 +157,8 @@ pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> T
         let (outputs, clear) = vector(gamma, quote!(out));
         cx.bounded("gamma", &outputs, clear, &out_vector, true)
     });
+    let length_scale = cx.length_scale(kin);
+    let branches = cx.branches(kin);
     let helpers = cx.helpers.into_inner();
     let helpers_impl = (!helpers.is_empty()).then(|| {
         quote! {
@@ -280,6 +282,18 @@ pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> T
         }
     });
 
+    let unit_list = |units: Vec<Unit>| {
+        let units = units.into_iter().map(|u| {
+            let variant = format_ident!("{}", u.name());
+            quote!(::mechgen_runtime::Unit::#variant)
+        });
+        quote!([#(#units),*])
+    };
+    let coordinate_units = unit_list(model.coordinate_units());
+    let equation_units = unit_list(model.equation_units());
+
+    let (branch_names_const, branch_methods) = branches.unwrap_or_default();
+
     let coordinate_doc = format!(
         " Coordinate names in q order ({n} = 3 × {} bodies).",
         model.bodies.len()
@@ -314,6 +328,11 @@ pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> T
             pub const PARAMETERS: [&'static str; #param_count] = [#(#param_names),*];
             #[doc = #pattern_doc]
             pub const JACOBIAN_PATTERN: [(usize, usize); #jacobian_count] = [#(#pattern),*];
+            /// Physical dimension of each coordinate, in q order (x, y lengths, θ angles).
+            pub const COORDINATE_UNITS: [::mechgen_runtime::Unit; #n_lit] = #coordinate_units;
+            /// Physical dimension of each equation, in Φ order.
+            pub const EQUATION_UNITS: [::mechgen_runtime::Unit; #n_lit] = #equation_units;
+            #branch_names_const
             #(#coordinate_consts)*
         }
 
@@ -360,6 +379,24 @@ pub fn emit_with(model: &Model, kin: &Kinematics, options: &CodegenOptions) -> T
                     _ => ::core::result::Result::Err(::mechgen_runtime::ParameterError::Unknown),
                 }
             }
+
+            fn coordinate_unit(&self, index: usize) -> ::mechgen_runtime::Unit {
+                Self::COORDINATE_UNITS
+                    .get(index)
+                    .copied()
+                    .unwrap_or(::mechgen_runtime::Unit::Angle)
+            }
+
+            fn equation_unit(&self, index: usize) -> ::mechgen_runtime::Unit {
+                Self::EQUATION_UNITS
+                    .get(index)
+                    .copied()
+                    .unwrap_or(::mechgen_runtime::Unit::Angle)
+            }
+
+            #length_scale
+
+            #branch_methods
 
             fn initial_guess(&self, q: &mut ::mechgen_runtime::Vector<Self::Dim>) {
                 #guess_body
@@ -492,6 +529,126 @@ impl Context<'_> {
         &self.model.arena
     }
 
+    /// `length_scale`: the constant lengths folded into one literal, the parameter-dependent
+    /// ones evaluated and folded in with `max(|v|)`, in the order of
+    /// [`LengthScale::evaluate`](crate::kinematics::LengthScale::evaluate).
+    fn length_scale(&self, kin: &Kinematics) -> TokenStream {
+        let scale = &kin.length_scale;
+        let constant = f64_literal(scale.constant);
+        let doc = format!(
+            " The largest magnitude among the scene's geometric lengths (body-fixed points, \
+             distances, ground positions){}.",
+            if scale.dependent.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    ": the constant ones folded into `{}`, {} parameter-dependent one{} \
+                     evaluated with the current parameters",
+                    scale.constant,
+                    scale.dependent.len(),
+                    if scale.dependent.len() == 1 { "" } else { "s" }
+                )
+            }
+        );
+        let body = if scale.dependent.is_empty() {
+            constant
+        } else {
+            let names: Vec<Ident> = (0..scale.dependent.len())
+                .map(|k| format_ident!("length{}", k))
+                .collect();
+            let outputs: Vec<(TokenStream, Id)> = names
+                .iter()
+                .zip(&scale.dependent)
+                .map(|(name, &id)| (quote!(let #name), id))
+                .collect();
+            let zero = names
+                .iter()
+                .zip(&scale.dependent)
+                .filter(|&(_, &id)| self.arena().is_zero(id))
+                .map(|(name, _)| quote! { let #name = 0.0f64; });
+            let zero: Vec<TokenStream> = zero.collect();
+            let evaluated = self.function(&outputs, TokenStream::new()).body;
+            quote! {
+                #evaluated
+                #(#zero)*
+                let scale: f64 = #constant;
+                scale #(.max(#names.abs()))*
+            }
+        };
+        quote! {
+            #[doc = #doc]
+            fn length_scale(&self) -> f64 {
+                #body
+            }
+        }
+    }
+
+    /// The `BRANCHES` names and the `branch_*` methods, or `None` for a scene without branch
+    /// invariants (the trait's defaults then say "none").
+    fn branches(&self, kin: &Kinematics) -> Option<(TokenStream, TokenStream)> {
+        if kin.branches.is_empty() {
+            return None;
+        }
+        let names: Vec<&str> = self
+            .model
+            .branches
+            .iter()
+            .map(|b| b.name.as_str())
+            .collect();
+        let count = idx(names.len());
+        let mut reads_q = false;
+        let arms = kin.branches.iter().enumerate().map(|(i, &id)| {
+            let value = if self.arena().is_zero(id) {
+                quote!(0.0)
+            } else {
+                let f = self.function(&[(TokenStream::new(), id)], TokenStream::new());
+                reads_q |= f.args[0] == "q";
+                let body = f.body;
+                quote! { { #body } }
+            };
+            let i = idx(i);
+            quote! { #i => #value, }
+        });
+        let arms: Vec<TokenStream> = arms.collect();
+        let q = if reads_q {
+            format_ident!("q")
+        } else {
+            format_ident!("_q")
+        };
+        let docs = self.model.branches.iter().map(|b| {
+            let line = format!(" - `{}`: `{}`", b.name, self.model.describe_branch(b));
+            quote! { #[doc = #line] }
+        });
+        let names_const = quote! {
+            /// Branch invariants, in declaration order:
+            ///
+            #(#docs)*
+            pub const BRANCHES: [&'static str; #count] = [#(#names),*];
+        };
+        let methods = quote! {
+            fn branch_count(&self) -> usize {
+                #count
+            }
+
+            fn branch_name(&self, index: usize) -> ::core::option::Option<&str> {
+                Self::BRANCHES.get(index).copied()
+            }
+
+            /// The invariant's value, signed to be positive on the declared branch.
+            fn branch_value(
+                &self,
+                index: usize,
+                #q: &::mechgen_runtime::Vector<Self::Dim>,
+            ) -> f64 {
+                match index {
+                    #(#arms)*
+                    _ => f64::NAN,
+                }
+            }
+        };
+        Some((names_const, methods))
+    }
+
     /// Like [`Context::function`], but a body larger than `max_function_size` operations is
     /// split: its outputs are grouped in order into parts of bounded size, each emitted as a
     /// helper method (recomputing the few shared sub-expressions a part needs), and the body
@@ -591,6 +748,9 @@ impl Context<'_> {
     }
 
     /// A function body writing `outputs` (non-zero entries; zeros are cleared in one call).
+    ///
+    /// An output with an empty target is written as a bare expression: as the last output, it
+    /// is the body's value (a block's tail).
     fn function(&self, outputs: &[(TokenStream, Id)], clear: TokenStream) -> Function {
         let arena = self.arena();
         let nonzero: Vec<&(TokenStream, Id)> = outputs
@@ -704,7 +864,11 @@ impl Context<'_> {
                     .clone()
                     .map_or_else(|| quote!(0.0), |(t, _)| t),
             };
-            quote! { #target = #value; }
+            if target.is_empty() {
+                value
+            } else {
+                quote! { #target = #value; }
+            }
         });
         let imports = if funcs.is_empty() {
             TokenStream::new()

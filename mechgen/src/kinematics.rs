@@ -7,8 +7,8 @@
 //! γ = −(∂Φ̇/∂q · q̇ + ∂Φ̇/∂t) = −(Φ_q q̇)_q q̇ − 2 Φ_qt q̇ − Φ_tt.
 
 use crate::diff::Differentiator;
-use crate::expr::{Arena, Id, Var};
-use crate::model::{ConstraintKind, Driven, Model, Outputs, Point};
+use crate::expr::{Arena, Id, Node, Var};
+use crate::model::{Branch, ConstraintKind, Driven, Model, Outputs, Point, Product, Sign};
 
 /// A structural non-zero of the Jacobian.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -34,6 +34,56 @@ pub struct Kinematics {
     pub gamma: Option<Vec<Id>>,
     /// The initial guess q₀ (ground poses and declared guesses), in parameters.
     pub guess: Vec<Id>,
+    /// The branch invariants' values in q (and parameters), in declaration order, each signed
+    /// so that it is positive on the declared branch (`< 0` invariants are negated).
+    pub branches: Vec<Id>,
+    /// The scene's length scale: the largest magnitude among its geometric lengths.
+    pub length_scale: LengthScale,
+}
+
+/// The largest magnitude among a scene's geometric lengths ([`Model::lengths`]), split into what
+/// is known at generation time and what depends on parameters.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LengthScale {
+    /// The largest magnitude among the constant lengths, folded; 1 when the scene has no
+    /// non-zero constant length and no parameter-dependent one (nothing to measure by).
+    pub constant: f64,
+    /// Lengths that depend on parameters, evaluated with the current values at run time.
+    pub dependent: Vec<Id>,
+}
+
+impl LengthScale {
+    /// Splits `lengths` into the folded constant maximum and the parameter-dependent rest.
+    pub fn of(arena: &Arena, lengths: &[Id]) -> Self {
+        let mut constant = 0.0f64;
+        let mut dependent = Vec::new();
+        for &id in lengths {
+            if arena.any_node(id, |n| matches!(n, Node::Param(_))) {
+                dependent.push(id);
+            } else {
+                // An unsimplified arena (naive baseline) does not fold: evaluate instead.
+                let value = arena.as_const(id).unwrap_or_else(|| {
+                    crate::interpret::eval(arena, id, &crate::interpret::Env::default())
+                });
+                constant = constant.max(value.abs());
+            }
+        }
+        if dependent.is_empty() && constant == 0.0 {
+            constant = 1.0;
+        }
+        LengthScale {
+            constant,
+            dependent,
+        }
+    }
+
+    /// The scale given the values of [`dependent`](Self::dependent), in order: the same
+    /// `max(|v|)` fold, in the same order, as the generated `length_scale`.
+    pub fn evaluate(&self, dependent: &[f64]) -> f64 {
+        dependent
+            .iter()
+            .fold(self.constant, |scale, v| scale.max(v.abs()))
+    }
 }
 
 impl Kinematics {
@@ -91,13 +141,54 @@ pub fn derive(model: &mut Model) -> Kinematics {
     }
 
     let guess = model.bodies.iter().flat_map(|b| b.pose).collect();
+    let branches = branch_values(model);
+    let length_scale = LengthScale::of(&model.arena, &model.lengths());
     Kinematics {
         phi,
         jacobian,
         nu,
         gamma,
         guess,
+        branches,
+        length_scale,
     }
+}
+
+/// The branch invariants' signed values, built from world points like the joints (ground
+/// bodies through their constant poses).
+fn branch_values(model: &mut Model) -> Vec<Id> {
+    let branches: Vec<Branch> = model.branches.clone();
+    let poses = ground_poses(model);
+    let mut f = Frames {
+        arena: &mut model.arena,
+        poses: &poses,
+    };
+    branches
+        .iter()
+        .map(|b| {
+            let u = f.vector(b.u);
+            let v = f.vector(b.v);
+            let value = match b.product {
+                Product::Dot => f.dot(u, v),
+                Product::Cross => {
+                    let (xy, yx) = (f.arena.mul(u[0], v[1]), f.arena.mul(u[1], v[0]));
+                    f.arena.sub(xy, yx)
+                }
+            };
+            match b.sign {
+                Sign::Positive => value,
+                Sign::Negative => f.arena.neg(value),
+            }
+        })
+        .collect()
+}
+
+fn ground_poses(model: &Model) -> Vec<Option<[Id; 3]>> {
+    model
+        .bodies
+        .iter()
+        .map(|b| b.ground.then_some(b.pose))
+        .collect()
 }
 
 /// γ_i = −(∂Φ̇_i/∂q · q̇ + ∂Φ̇_i/∂t) with Φ̇_i = Σ_k Φ_q[i,k] q̇_k + Φ_t,i.
@@ -139,13 +230,9 @@ fn col_u32(col: usize) -> u32 {
 /// and in Cartesian form), but every joint and driver sees a ground body through its constant
 /// pose: the solutions are the same, and ground bodies cost no trigonometry and no Jacobian
 /// entries outside their own rows.
-fn constraint_equations(model: &mut Model) -> Vec<Id> {
+pub(crate) fn constraint_equations(model: &mut Model) -> Vec<Id> {
     let constraints: Vec<ConstraintKind> = model.constraints.iter().map(|c| c.kind).collect();
-    let poses: Vec<Option<[Id; 3]>> = model
-        .bodies
-        .iter()
-        .map(|b| b.ground.then_some(b.pose))
-        .collect();
+    let poses = ground_poses(model);
     let mut f = Frames {
         arena: &mut model.arena,
         poses: &poses,
@@ -231,6 +318,18 @@ impl Frames<'_> {
         [self.arena.sub(rt[0], rf[0]), self.arena.sub(rt[1], rf[1])]
     }
 
+    /// The world vector from `points[0]` to `points[1]`; between two points of one body it is
+    /// that body's rotation of their difference (the body's position cancels exactly).
+    fn vector(&mut self, points: [Point; 2]) -> [Id; 2] {
+        let [from, to] = points;
+        if from.body == to.body {
+            let d = [0, 1].map(|k| self.arena.sub(to.local[k], from.local[k]));
+            self.rotate(from.body, d)
+        } else {
+            self.separation(from, to)
+        }
+    }
+
     fn dot(&mut self, u: [Id; 2], v: [Id; 2]) -> Id {
         let (x, y) = (self.arena.mul(u[0], v[0]), self.arena.mul(u[1], v[1]));
         self.arena.add(x, y)
@@ -251,5 +350,69 @@ impl Frames<'_> {
                 self.dot(u, d)
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::interpret::{Env, eval};
+
+    fn compile(source: &str) -> crate::Scene {
+        crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn length_scale_folds_constants_and_keeps_parameters() {
+        let scene = compile(
+            "mechanism M {
+                param r = 3;
+                ground f at (-7, 2, 0.5);
+                body a near (50, 60, 1);
+                body b near (0, 0, 0);
+                joint pin: revolute(f @ (1, -2), a @ (r, 0));
+                joint rod: distance(a @ (-4, 0), b, 5);
+                joint guide: prismatic(f, b, along (100, 0));
+                driver d: angle(a) = 1000 * t;
+            }",
+        );
+        // 7 (ground x), 4 (a point), 5 (distance); not the guesses, axes or driver values.
+        let scale = &scene.kinematics.length_scale;
+        assert_eq!(scale.constant, 7.0);
+        assert_eq!(scale.dependent.len(), 1);
+        assert_eq!(scale.evaluate(&[-9.0]), 9.0);
+        assert_eq!(scale.evaluate(&[2.0]), 7.0);
+
+        let fixed = compile(
+            "mechanism M { ground f at (0, 0, 0); body a near (1, 0, 0);
+               joint pin: revolute(f, a); driver d: angle(a) = t; }",
+        );
+        assert_eq!(fixed.kinematics.length_scale.constant, 1.0);
+        assert!(fixed.kinematics.length_scale.dependent.is_empty());
+    }
+
+    #[test]
+    fn branch_values_are_signed_products_of_world_vectors() {
+        let scene = compile(
+            "mechanism M {
+                ground f at (1, 0, 0);
+                body a near (0, 0, 0);
+                joint pin: revolute(f, a @ (0, 0));
+                driver d: angle(a) = t;
+                branch left: cross(f -> a @ (2, 0), a -> a @ (0, 3)) > 0;
+                branch right: dot(f -> a @ (2, 0), f @ (0, 1) -> f) < 0;
+            }",
+        );
+        let [left, right] = [scene.kinematics.branches[0], scene.kinematics.branches[1]];
+        // a at (5, 1) turned a quarter: a @ (2, 0) is at (5, 3), a @ (0, 3) at (2, 1).
+        let env = Env {
+            q: vec![1.0, 0.0, 0.0, 5.0, 1.0, std::f64::consts::FRAC_PI_2],
+            ..Env::default()
+        };
+        let arena = &scene.model.arena;
+        let (u, v, w) = ([4.0, 3.0], [-3.0, 0.0], [0.0, -1.0]);
+        let cross = u[0] * v[1] - u[1] * v[0];
+        assert!((eval(arena, left, &env) - cross).abs() < 1e-12);
+        let dot = u[0] * w[0] + u[1] * w[1];
+        assert!((eval(arena, right, &env) + dot).abs() < 1e-12);
     }
 }

@@ -6,6 +6,7 @@
 use syn::{Attribute, Ident, Visibility};
 
 use crate::expr::{Arena, Id};
+pub use crate::spec::{Product, Sign};
 
 /// The checked mechanism.
 #[derive(Clone)]
@@ -24,6 +25,8 @@ pub struct Model {
     pub bodies: Vec<Body>,
     /// Constraints in equation order: ground bodies, then joints, then drivers.
     pub constraints: Vec<Constraint>,
+    /// Branch invariants in declaration order (their values are derived by `kinematics`).
+    pub branches: Vec<Branch>,
     /// What the scene asked to compute.
     pub outputs: Outputs,
 }
@@ -137,6 +140,47 @@ pub enum ConstraintKind {
     },
 }
 
+/// A branch invariant: `product(u, v)` of two world vectors between body-fixed points keeps
+/// `sign` on the declared assembly branch.
+#[derive(Clone)]
+pub struct Branch {
+    /// Name as declared.
+    pub name: String,
+    /// Doc comments.
+    pub docs: Vec<Attribute>,
+    /// `cross` or `dot`.
+    pub product: Product,
+    /// The first vector, from `u[0]` to `u[1]`.
+    pub u: [Point; 2],
+    /// The second vector, from `v[0]` to `v[1]`.
+    pub v: [Point; 2],
+    /// The sign the product keeps on the declared branch.
+    pub sign: Sign,
+}
+
+/// Physical dimension of a coordinate or an equation (mirrors `mechgen_runtime::Unit`, which
+/// generated code names; the runtime scales by it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Unit {
+    /// Radians.
+    Angle,
+    /// A length.
+    Length,
+    /// A length squared.
+    Area,
+}
+
+impl Unit {
+    /// The variant's name (`Angle`, `Length`, `Area`), as in `mechgen_runtime::Unit`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Unit::Angle => "Angle",
+            Unit::Length => "Length",
+            Unit::Area => "Area",
+        }
+    }
+}
+
 /// The quantity a driver prescribes.
 #[derive(Clone, Copy)]
 pub enum Driven {
@@ -169,10 +213,46 @@ impl ConstraintKind {
             ConstraintKind::Distance { .. } | ConstraintKind::Driver { .. } => &[""],
         }
     }
+
+    /// Physical dimension of each of this constraint's equations, in the order of
+    /// [`equation_suffixes`](Self::equation_suffixes): point coincidences and positions are
+    /// lengths, angles are angles, a prismatic joint's normal offset is a length (its axis is a
+    /// unit vector), and a distance joint's `|d|² − L²` is an area.
+    pub fn equation_units(&self) -> &'static [Unit] {
+        match self {
+            ConstraintKind::Ground { .. } => &[Unit::Length, Unit::Length, Unit::Angle],
+            ConstraintKind::Revolute { .. } => &[Unit::Length, Unit::Length],
+            ConstraintKind::Prismatic { .. } => &[Unit::Length, Unit::Angle],
+            ConstraintKind::Distance { .. } => &[Unit::Area],
+            ConstraintKind::Driver { driven, .. } => match driven {
+                Driven::Angle(_) | Driven::RelativeAngle(..) => &[Unit::Angle],
+                Driven::X(_) | Driven::Y(_) | Driven::Travel { .. } => &[Unit::Length],
+            },
+        }
+    }
+
+    /// The body-fixed points this constraint places (none for ground equations and angle
+    /// drivers).
+    pub fn points(&self) -> Vec<Point> {
+        match *self {
+            ConstraintKind::Ground { .. } => Vec::new(),
+            ConstraintKind::Revolute { a, b }
+            | ConstraintKind::Prismatic { a, b, .. }
+            | ConstraintKind::Distance { a, b, .. } => vec![a, b],
+            ConstraintKind::Driver { driven, .. } => match driven {
+                Driven::Angle(_) | Driven::RelativeAngle(..) => Vec::new(),
+                Driven::X(p) | Driven::Y(p) => vec![p],
+                Driven::Travel { a, b, .. } => vec![a, b],
+            },
+        }
+    }
 }
 
 /// Names of a body's coordinates, in q order.
 pub const COORDINATE_SUFFIXES: [&str; 3] = ["x", "y", "theta"];
+
+/// Physical dimensions of a body's coordinates, in q order: x, y lengths, θ an angle.
+pub const COORDINATE_UNITS: [Unit; 3] = [Unit::Length, Unit::Length, Unit::Angle];
 
 impl Model {
     /// Number of coordinates (= number of equations, checked).
@@ -202,6 +282,83 @@ impl Model {
                 })
             })
             .collect()
+    }
+
+    /// Physical dimension of every coordinate, in q order.
+    pub fn coordinate_units(&self) -> Vec<Unit> {
+        self.bodies.iter().flat_map(|_| COORDINATE_UNITS).collect()
+    }
+
+    /// Physical dimension of every equation, in Φ order.
+    pub fn equation_units(&self) -> Vec<Unit> {
+        self.constraints
+            .iter()
+            .flat_map(|c| c.kind.equation_units().iter().copied())
+            .collect()
+    }
+
+    /// The scene's geometric lengths, as expressions in parameters, each once (ids are
+    /// hash-consed) and in declaration order: the body-frame coordinates of every joint and
+    /// driver point, every distance joint's length and every ground body's x and y. Not the
+    /// guesses of moving bodies (only a starting point) nor driver values (they depend on t).
+    /// Their largest magnitude is the scene's length scale.
+    pub fn lengths(&self) -> Vec<Id> {
+        let mut lengths = Vec::new();
+        let mut seen = std::collections::HashSet::new();
+        let mut add = |id: Id| {
+            if seen.insert(id) {
+                lengths.push(id);
+            }
+        };
+        for body in self.bodies.iter().filter(|b| b.ground) {
+            add(body.pose[0]);
+            add(body.pose[1]);
+        }
+        for constraint in &self.constraints {
+            for point in constraint.kind.points() {
+                add(point.local[0]);
+                add(point.local[1]);
+            }
+            if let ConstraintKind::Distance { length, .. } = constraint.kind {
+                add(length);
+            }
+        }
+        lengths
+    }
+
+    /// A point as the spec writes it: `rod @ (41.3, 0)`, `rod` for a reference point, and
+    /// `rod @ (…)` for coordinates that depend on parameters.
+    pub fn describe_point(&self, p: Point) -> String {
+        let body = self
+            .bodies
+            .get(p.body)
+            .map_or_else(|| "?".to_owned(), |b| b.name.to_string());
+        match p.local.map(|id| self.arena.as_const(id)) {
+            [Some(x), Some(y)] if x == 0.0 && y == 0.0 => body,
+            [Some(x), Some(y)] => format!("{body} @ ({x}, {y})"),
+            _ => format!("{body} @ (…)"),
+        }
+    }
+
+    /// A branch invariant as the spec writes it: `dot(bearing -> liner, rod @ (41.3, 0) -> …) > 0`.
+    pub fn describe_branch(&self, b: &Branch) -> String {
+        let vector = |v: [Point; 2]| {
+            format!(
+                "{} -> {}",
+                self.describe_point(v[0]),
+                self.describe_point(v[1])
+            )
+        };
+        let sign = match b.sign {
+            Sign::Positive => ">",
+            Sign::Negative => "<",
+        };
+        format!(
+            "{}({}, {}) {sign} 0",
+            b.product.name(),
+            vector(b.u),
+            vector(b.v)
+        )
     }
 
     /// Number of drivers (the mechanism's degrees of freedom, checked).

@@ -13,11 +13,20 @@
 //!     joint link: distance(a @ (0, 10), b, 120);
 //!     driver crank: angle(crank) = omega * t;   also relative_angle(a, b), x(point),
 //!                                                y(point), travel(prismatic_joint)
+//!     branch open: cross(a @ (1, 0) -> b, b -> c) > 0;
+//!                                               branch invariant; also dot(…), and `< 0`
 //!     outputs positions, velocities;            optional; default: all three
 //! }
 //! ```
 //!
 //! A point is `body @ (x, y)` in the body's frame, or `body` alone for its reference point.
+//!
+//! A branch invariant `branch NAME: cross(p1 -> p2, p3 -> p4) > 0;` (or `dot(…)`, or `< 0`)
+//! declares which assembly branch the mechanism stays on: `p1 -> p2` is the world vector from
+//! point `p1` to point `p2` (points as in joints), `cross(u, v)` = u.x v.y − u.y v.x,
+//! `dot(u, v)` = u.x v.x + u.y v.y, compared strictly with the literal `0`. The solver refuses a
+//! solution where the sign is wrong instead of switching branch silently.
+//!
 //! Expressions use numbers, `t`, parameters, `+ - * /`, unary minus, `^` with an integer
 //! exponent, parentheses and `sin cos tan exp ln sqrt`. Only syntax is checked here.
 
@@ -26,8 +35,8 @@ use syn::parse::{Parse, ParseStream};
 use syn::{Attribute, Ident, LitFloat, LitInt, Token, Visibility, braced, parenthesized};
 
 use crate::spec::{
-    BinOp, BodyDecl, DriverDecl, DriverKind, Expr, ExprKind, JointDecl, JointKind, ParamDecl,
-    PointRef, Spec,
+    BinOp, BodyDecl, BranchDecl, DriverDecl, DriverKind, Expr, ExprKind, JointDecl, JointKind,
+    ParamDecl, PointRef, Product, Sign, Spec,
 };
 
 mod kw {
@@ -41,6 +50,7 @@ mod kw {
     syn::custom_keyword!(near);
     syn::custom_keyword!(along);
     syn::custom_keyword!(outputs);
+    syn::custom_keyword!(branch);
 }
 
 /// Parses a `mechanism` declaration from tokens (the macro's input).
@@ -82,6 +92,7 @@ impl Parse for Spec {
             bodies: Vec::new(),
             joints: Vec::new(),
             drivers: Vec::new(),
+            branches: Vec::new(),
             outputs: None,
         };
         while !content.is_empty() {
@@ -186,11 +197,86 @@ fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> {
             kind,
             value,
         });
+    } else if look.peek(kw::branch) {
+        input.parse::<kw::branch>()?;
+        let name = input.parse()?;
+        input.parse::<Token![:]>()?;
+        spec.branches.push(branch(input, docs, name)?);
     } else {
         return Err(look.error());
     }
     input.parse::<Token![;]>()?;
     Ok(())
+}
+
+/// `cross(p1 -> p2, p3 -> p4) > 0` (after `branch NAME:`); the right-hand side is parsed as an
+/// expression and held to the literal 0 by `check`, so that mistake is reported with the others.
+fn branch(input: ParseStream, docs: Vec<Attribute>, name: Ident) -> syn::Result<BranchDecl> {
+    let kind: Ident = input.parse()?;
+    let product = match kind.to_string().as_str() {
+        "cross" => Product::Cross,
+        "dot" => Product::Dot,
+        other => {
+            return Err(syn::Error::new(
+                kind.span(),
+                format!(
+                    "unknown branch invariant `{other}`; expected `cross(p1 -> p2, p3 -> p4)` \
+                     or `dot(p1 -> p2, p3 -> p4)`"
+                ),
+            ));
+        }
+    };
+    let args;
+    parenthesized!(args in input);
+    let u = vector(&args)?;
+    args.parse::<Token![,]>()?;
+    let v = vector(&args)?;
+    if !args.is_empty() {
+        return Err(args.error(
+            "unexpected argument; a branch invariant takes two vectors: `p1 -> p2, p3 -> p4`",
+        ));
+    }
+    let strict = "compare a branch invariant strictly with zero: `> 0` or `< 0`";
+    if input.peek(Token![>=])
+        || input.peek(Token![<=])
+        || input.peek(Token![==])
+        || input.peek(Token![!=])
+    {
+        return Err(input.error(strict));
+    }
+    let sign = if input.peek(Token![>]) {
+        input.parse::<Token![>]>()?;
+        Sign::Positive
+    } else if input.peek(Token![<]) {
+        input.parse::<Token![<]>()?;
+        Sign::Negative
+    } else {
+        return Err(input.error(strict));
+    };
+    let zero = input.parse()?;
+    Ok(BranchDecl {
+        docs,
+        name,
+        product,
+        product_span: kind.span(),
+        u,
+        v,
+        sign,
+        zero,
+    })
+}
+
+/// `p1 -> p2`: the world vector from one point to another.
+fn vector(input: ParseStream) -> syn::Result<[PointRef; 2]> {
+    let from = input.parse()?;
+    input.parse::<Token![->]>().map_err(|e| {
+        syn::Error::new(
+            e.span(),
+            "expected `->`: a vector is written `from -> to`, such as `rod @ (0, 10) -> crank`",
+        )
+    })?;
+    let to = input.parse()?;
+    Ok([from, to])
 }
 
 fn joint_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, JointKind)> {
@@ -515,5 +601,32 @@ mod tests {
         assert!(err("mechanism M { param p = t^x; }").contains("integer exponent"));
         assert!(err("#[derive(Debug)] mechanism M {}").contains("only doc comments"));
         assert!(err("struct M {}").contains("mechanism Name"));
+        assert!(err("mechanism M { branch b: cross(a -> b, c -> d) >= 0; }").contains("strictly"));
+        assert!(err("mechanism M { branch b: cross(a -> b, c -> d); }").contains("`> 0` or `< 0`"));
+        assert!(err("mechanism M { branch b: wedge(a -> b, c -> d) > 0; }").contains("`wedge`"));
+        assert!(err("mechanism M { branch b: dot(a, b, c -> d) > 0; }").contains("`->`"));
+    }
+
+    #[test]
+    fn parses_branch_invariants() {
+        let spec = parse_str(
+            "mechanism M {
+                /// Open assembly.
+                branch open: cross(a @ (1, 0) -> b, b -> c @ (0, -2.5)) < 0;
+                branch out: dot(a -> b, c -> d) > 0.0;
+            }",
+        )
+        .unwrap_or_else(|e| panic!("parses: {e}"));
+        assert_eq!(spec.branches.len(), 2);
+        let open = &spec.branches[0];
+        assert_eq!(open.name, "open");
+        assert_eq!(open.docs.len(), 1);
+        assert_eq!((open.product, open.sign), (Product::Cross, Sign::Negative));
+        assert_eq!(open.u[0].body, "a");
+        assert!(open.u[1].local.is_none());
+        assert_eq!(open.v[1].body, "c");
+        let out = &spec.branches[1];
+        assert_eq!((out.product, out.sign), (Product::Dot, Sign::Positive));
+        assert_eq!(show(&out.zero), "0");
     }
 }

@@ -22,6 +22,8 @@ pub struct Spec {
     pub joints: Vec<JointDecl>,
     /// Drivers in declaration order.
     pub drivers: Vec<DriverDecl>,
+    /// Branch invariants in declaration order.
+    pub branches: Vec<BranchDecl>,
     /// The `outputs …;` statement, if any: the listed names with their spans.
     pub outputs: Option<Vec<proc_macro2::Ident>>,
 }
@@ -135,6 +137,56 @@ pub enum DriverKind {
     Y(PointRef),
     /// `travel(joint)`: position of a prismatic joint's slider along its axis.
     Travel(Ident),
+}
+
+/// `branch NAME: cross(p1 -> p2, p3 -> p4) > 0;` (or `dot(…)`, or `< 0`): a sign that tells the
+/// declared assembly branch from its mirror image, which the solver refuses to leave.
+#[derive(Clone)]
+pub struct BranchDecl {
+    /// Doc comments.
+    pub docs: Vec<Attribute>,
+    /// Name of the invariant (reported by the solver when a solution leaves the branch).
+    pub name: Ident,
+    /// `cross` or `dot`.
+    pub product: Product,
+    /// Span of the product's name, for diagnostics about the whole invariant.
+    pub product_span: Span,
+    /// The first vector, from its first point to its second (world coordinates).
+    pub u: [PointRef; 2],
+    /// The second vector.
+    pub v: [PointRef; 2],
+    /// `> 0` or `< 0`.
+    pub sign: Sign,
+    /// The right-hand side of the comparison as written; `check` requires the literal 0.
+    pub zero: Expr,
+}
+
+/// The product of a branch invariant's two vectors.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Product {
+    /// `cross(u, v)` = u.x v.y − u.y v.x: the sign of the turn from u to v.
+    Cross,
+    /// `dot(u, v)` = u.x v.x + u.y v.y: whether u and v point the same way.
+    Dot,
+}
+
+impl Product {
+    /// The name used in specs (`cross`, `dot`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Product::Cross => "cross",
+            Product::Dot => "dot",
+        }
+    }
+}
+
+/// The sign a branch invariant keeps on the declared branch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Sign {
+    /// `> 0`
+    Positive,
+    /// `< 0`
+    Negative,
 }
 
 /// An expression as written, in `t`, parameters and numbers.

@@ -11,6 +11,8 @@ use crate::mechanism::{Mechanism, Storage};
 pub enum Quantity {
     /// The time passed in.
     Time,
+    /// A run-time parameter of the scene (its index).
+    Parameter(usize),
     /// The initial guess, or the positions passed to a velocity or acceleration solve.
     Guess,
     /// The constraint vector Φ.
@@ -27,28 +29,47 @@ pub enum Quantity {
     Velocity,
     /// The solved accelerations q̈.
     Acceleration,
+    /// A branch invariant of the scene (its index).
+    Branch(usize),
+}
+
+impl Quantity {
+    fn write(self, f: &mut fmt::Formatter<'_>, name: Option<&str>) -> fmt::Result {
+        match (self, name) {
+            (Self::Parameter(_), Some(name)) => write!(f, "parameter `{name}`"),
+            (Self::Parameter(index), None) => write!(f, "parameter #{index}"),
+            (Self::Branch(_), Some(name)) => write!(f, "branch invariant `{name}`"),
+            (Self::Branch(index), None) => write!(f, "branch invariant #{index}"),
+            _ => f.write_str(match self {
+                Self::Time => "the time",
+                Self::Guess => "the positions q (initial guess)",
+                Self::Phi => "the constraints Φ",
+                Self::Jacobian => "the Jacobian Φ_q",
+                Self::Nu => "the velocity right-hand side ν",
+                Self::Gamma => "the acceleration right-hand side γ",
+                Self::Step => "the Newton step Δq",
+                Self::Velocity => "the velocities q̇",
+                Self::Acceleration => "the accelerations q̈",
+                Self::Parameter(_) | Self::Branch(_) => "",
+            }),
+        }
+    }
 }
 
 impl fmt::Display for Quantity {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            Self::Time => "the time",
-            Self::Guess => "the positions q (initial guess)",
-            Self::Phi => "the constraints Φ",
-            Self::Jacobian => "the Jacobian Φ_q",
-            Self::Nu => "the velocity right-hand side ν",
-            Self::Gamma => "the acceleration right-hand side γ",
-            Self::Step => "the Newton step Δq",
-            Self::Velocity => "the velocities q̇",
-            Self::Acceleration => "the accelerations q̈",
-        })
+        self.write(f, None)
     }
 }
 
-/// A failed position, velocity or acceleration solve.
+/// A failed position, velocity or acceleration solve: what went wrong, and when.
+///
+/// Indices name equations, coordinates, branches and parameters of the scene; name them with
+/// [`SolveError::describe`] (the first equation and coordinate involved) or
+/// [`crate::Solver::describe`] (every one).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SolveError {
-    /// Newton–Raphson hit the iteration cap; the mechanism may not be able to assemble at `time`.
+    /// Newton–Raphson hit the iteration cap while still reducing the residual.
     NoConvergence {
         /// Time of the solve.
         time: f64,
@@ -57,19 +78,45 @@ pub enum SolveError {
         /// ‖Φ‖∞ at the last iterate.
         residual: f64,
     },
-    /// Φ_q has no usable pivot: the mechanism is locked, over- or under-constrained here.
+    /// The constraints cannot all be satisfied: the least-squares residual stopped decreasing
+    /// well above the tolerance (links too short to close, a driver beyond the reachable range,
+    /// inconsistent redundant constraints).
+    NoAssembly {
+        /// Time of the solve.
+        time: f64,
+        /// Newton and Levenberg–Marquardt updates applied.
+        iterations: usize,
+        /// ‖Φ‖∞ at the best point reached.
+        residual: f64,
+        /// The equation with the largest scaled residual there.
+        equation: usize,
+    },
+    /// Φ_q is singular or too ill-conditioned to trust at the solution: a toggle (dead-point)
+    /// position, or redundant constraints.
     ///
-    /// `equation` and `coordinate` are indices; name them with
-    /// [`Mechanism::equation_name`] / [`Mechanism::coordinate_name`] or [`SolveError::describe`].
+    /// `equation` is the first of the `deficiency` dependent equations and `coordinate` the
+    /// first coordinate they leave undetermined; [`crate::Solver::dependent_equations`] lists all.
     Singular {
         /// Time of the solve.
         time: f64,
-        /// The likeliest redundant or conflicting equation.
+        /// First dependent (redundant) equation.
         equation: usize,
-        /// The coordinate the equations failed to determine.
+        /// First undetermined coordinate.
         coordinate: usize,
-        /// Magnitude of the best available pivot.
-        pivot: f64,
+        /// Condition estimate κ₁ of the unit-scaled Φ_q (infinite when a pivot vanished).
+        condition: f64,
+        /// How many equations depend on the others (n − numerical rank).
+        deficiency: usize,
+    },
+    /// The solution has a branch invariant of the wrong sign: the mechanism would flip to
+    /// another assembly branch (through a singular position, or by a too coarse time step).
+    BranchFlip {
+        /// Time of the solve.
+        time: f64,
+        /// The branch invariant's index.
+        branch: usize,
+        /// Its value (signed: positive on the declared branch).
+        value: f64,
     },
     /// An input or an evaluated quantity was NaN or infinite.
     NonFinite {
@@ -87,18 +134,39 @@ pub enum SolveError {
     },
 }
 
+/// Names for an error's indices, looked up in the mechanism (and the solver's diagnosis).
+#[derive(Default)]
+struct Names<'a> {
+    equation: Option<&'a str>,
+    coordinate: Option<&'a str>,
+    branch: Option<&'a str>,
+    parameter: Option<&'a str>,
+}
+
 impl SolveError {
     /// The time at which the solve failed, if the error concerns one.
     pub fn time(&self) -> Option<f64> {
         match *self {
             Self::NoConvergence { time, .. }
+            | Self::NoAssembly { time, .. }
             | Self::Singular { time, .. }
+            | Self::BranchFlip { time, .. }
             | Self::NonFinite { time, .. } => Some(time),
             Self::DimensionMismatch { .. } => None,
         }
     }
 
-    /// Displays the error with the mechanism's equation and coordinate names instead of indices.
+    /// Whether a smaller time step may get past this failure (the simulation sub-steps on these):
+    /// the Newton iteration lost its way, as opposed to a property of the configuration or of
+    /// the input.
+    pub fn is_step_related(&self) -> bool {
+        matches!(
+            self,
+            Self::NoConvergence { .. } | Self::NoAssembly { .. } | Self::BranchFlip { .. }
+        )
+    }
+
+    /// Displays the error with the mechanism's names instead of indices.
     pub fn describe<'a, M: Mechanism>(&'a self, mechanism: &'a M) -> Described<'a, M>
     where
         DefaultAllocator: Storage<M::Dim>,
@@ -106,10 +174,16 @@ impl SolveError {
         Described {
             error: self,
             mechanism,
+            dependent: &[],
+            undetermined: &[],
         }
     }
 
-    fn write(&self, f: &mut fmt::Formatter<'_>, names: Option<(&str, &str)>) -> fmt::Result {
+    fn write(&self, f: &mut fmt::Formatter<'_>, names: &Names<'_>) -> fmt::Result {
+        let equation = |f: &mut fmt::Formatter<'_>, index: usize| match names.equation {
+            Some(name) => write!(f, "`{name}`"),
+            None => write!(f, "#{index}"),
+        };
         match *self {
             Self::NoConvergence {
                 time,
@@ -118,32 +192,66 @@ impl SolveError {
             } => write!(
                 f,
                 "no convergence at t = {time} after {iterations} Newton iterations \
-                 (‖Φ‖∞ = {residual:e}); the mechanism may not assemble here"
+                 (‖Φ‖∞ = {residual:e}); try a smaller time step or a better initial guess"
             ),
-            Self::Singular {
+            Self::NoAssembly {
                 time,
-                equation,
-                coordinate,
-                pivot,
+                iterations,
+                residual,
+                equation: index,
             } => {
-                write!(f, "singular Jacobian at t = {time}: ")?;
-                match names {
-                    Some((equation, coordinate)) => {
-                        write!(f, "equation {equation} / coordinate {coordinate}")?;
-                    }
-                    None => write!(
-                        f,
-                        "equation #{equation} / coordinate #{coordinate} (see \
-                         Mechanism::equation_name / coordinate_name)"
-                    )?,
-                }
                 write!(
                     f,
-                    " is redundant, conflicting or locked (|pivot| = {pivot:e})"
+                    "the mechanism cannot assemble at t = {time}: after {iterations} iterations \
+                     the residual stopped at ‖Φ‖∞ = {residual:e}, largest in equation "
+                )?;
+                equation(f, index)?;
+                f.write_str("; check the link lengths and the driver values (can the loop close?)")
+            }
+            Self::Singular {
+                time,
+                equation: index,
+                coordinate,
+                condition,
+                deficiency,
+            } => {
+                write!(
+                    f,
+                    "singular Jacobian at t = {time} (condition estimate {condition:.3e} of the \
+                     scaled Φ_q): {deficiency} equation{} depend{} on the others; equation ",
+                    if deficiency == 1 { "" } else { "s" },
+                    if deficiency == 1 { "s" } else { "" },
+                )?;
+                equation(f, index)?;
+                match names.coordinate {
+                    Some(name) => write!(f, " leaves coordinate `{name}` undetermined")?,
+                    None => write!(f, " leaves coordinate #{coordinate} undetermined")?,
+                }
+                f.write_str(
+                    " (a toggle/dead-point position, or redundant constraints: remove one of \
+                     the dependent equations' joints or drivers)",
+                )
+            }
+            Self::BranchFlip {
+                time,
+                branch,
+                value,
+            } => {
+                write!(
+                    f,
+                    "the solution at t = {time} is on another assembly branch: "
+                )?;
+                Quantity::Branch(branch).write(f, names.branch)?;
+                write!(
+                    f,
+                    " is {value:e} (should be positive); stepping, the motion passes through a \
+                     singular position or the step is too coarse; assembling, move the initial \
+                     guess towards the declared branch"
                 )
             }
             Self::NonFinite { time, quantity } => {
-                write!(f, "{quantity} became NaN or infinite at t = {time}")
+                quantity.write(f, names.parameter.or(names.branch))?;
+                write!(f, " became NaN or infinite at t = {time}")
             }
             Self::DimensionMismatch { expected, found } => {
                 write!(
@@ -157,7 +265,7 @@ impl SolveError {
 
 impl fmt::Display for SolveError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.write(f, None)
+        self.write(f, &Names::default())
     }
 }
 
@@ -165,8 +273,12 @@ impl core::error::Error for SolveError {}
 
 /// A [`SolveError`] displayed with names from its mechanism; see [`SolveError::describe`].
 pub struct Described<'a, M> {
-    error: &'a SolveError,
-    mechanism: &'a M,
+    pub(crate) error: &'a SolveError,
+    pub(crate) mechanism: &'a M,
+    /// Every dependent equation of a `Singular` error, when the solver's diagnosis is at hand.
+    pub(crate) dependent: &'a [usize],
+    /// Every undetermined coordinate of a `Singular` error, likewise.
+    pub(crate) undetermined: &'a [usize],
 }
 
 impl<M: Mechanism> fmt::Display for Described<'_, M>
@@ -174,18 +286,52 @@ where
     DefaultAllocator: Storage<M::Dim>,
 {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let names = match *self.error {
+        let m = self.mechanism;
+        let mut names = Names::default();
+        match *self.error {
             SolveError::Singular {
                 equation,
                 coordinate,
                 ..
-            } => self
-                .mechanism
-                .equation_name(equation)
-                .zip(self.mechanism.coordinate_name(coordinate)),
-            _ => None,
-        };
-        self.error.write(f, names)
+            } => {
+                names.equation = m.equation_name(equation);
+                names.coordinate = m.coordinate_name(coordinate);
+            }
+            SolveError::NoAssembly { equation, .. } => names.equation = m.equation_name(equation),
+            SolveError::BranchFlip { branch, .. } => names.branch = m.branch_name(branch),
+            SolveError::NonFinite {
+                quantity: Quantity::Parameter(index),
+                ..
+            } => names.parameter = m.parameter_name(index),
+            SolveError::NonFinite {
+                quantity: Quantity::Branch(index),
+                ..
+            } => names.branch = m.branch_name(index),
+            _ => {}
+        }
+        self.error.write(f, &names)?;
+        let lists = [
+            ("dependent equations", self.dependent, true),
+            ("undetermined coordinates", self.undetermined, false),
+        ];
+        for (what, indices, equations) in lists {
+            if indices.is_empty() {
+                continue;
+            }
+            write!(f, "\n  {what}:")?;
+            for &index in indices {
+                let name = if equations {
+                    m.equation_name(index)
+                } else {
+                    m.coordinate_name(index)
+                };
+                match name {
+                    Some(name) => write!(f, " {name}")?,
+                    None => write!(f, " #{index}")?,
+                }
+            }
+        }
+        Ok(())
     }
 }
 
@@ -201,15 +347,60 @@ mod tests {
             time: 1.0,
             equation: 2,
             coordinate: 1,
-            pivot: 0.0,
+            condition: f64::INFINITY,
+            deficiency: 1,
         };
         let plain = error.to_string();
-        assert!(plain.contains("equation #2 / coordinate #1"), "{plain}");
+        assert!(plain.contains("1 equation depends"), "{plain}");
+        assert!(
+            plain.contains("equation #2 leaves coordinate #1"),
+            "{plain}"
+        );
         let named = error.describe(&Pendulum::default()).to_string();
         assert!(
-            named.contains("equation drive / coordinate rod.y"),
+            named.contains("equation `drive` leaves coordinate `rod.y` undetermined"),
             "{named}"
         );
         assert_eq!(error.time(), Some(1.0));
+    }
+
+    #[test]
+    fn every_error_says_when_and_what() {
+        let pendulum = Pendulum::default();
+        let errors = [
+            SolveError::NoAssembly {
+                time: 0.5,
+                iterations: 9,
+                residual: 1.5,
+                equation: 0,
+            },
+            SolveError::BranchFlip {
+                time: 0.5,
+                branch: 0,
+                value: -1.0,
+            },
+            SolveError::NonFinite {
+                time: 0.5,
+                quantity: Quantity::Parameter(3),
+            },
+            SolveError::NoConvergence {
+                time: 0.5,
+                iterations: 25,
+                residual: 1e-3,
+            },
+        ];
+        for error in errors {
+            let text = error.describe(&pendulum).to_string();
+            assert!(text.contains("t = 0.5"), "{text}");
+            assert_eq!(error.time(), Some(0.5));
+        }
+        assert!(
+            errors[0]
+                .describe(&pendulum)
+                .to_string()
+                .contains("`pin.x`")
+        );
+        assert!(errors[2].to_string().contains("parameter #3"));
+        assert!(errors[0].is_step_related() && !errors[2].is_step_related());
     }
 }

@@ -24,6 +24,7 @@ pub mod math;
 mod mechanism;
 #[cfg(test)]
 mod pendulum;
+mod position;
 mod simulate;
 mod solver;
 mod state;
@@ -31,7 +32,7 @@ mod state;
 pub use error::{Described, Quantity, SolveError};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use mechanism::{
-    Accelerations, Matrix, Mechanism, Outputs, ParameterError, Storage, Vector, Velocities,
+    Accelerations, Matrix, Mechanism, Outputs, ParameterError, Storage, Unit, Vector, Velocities,
 };
 pub use simulate::{Simulation, sample_time};
 pub use solver::{Convergence, Solver, SolverOptions, solve_accelerations, solve_velocities};

@@ -51,6 +51,33 @@ pub enum Outputs {
     Accelerations,
 }
 
+/// Physical dimension of a coordinate or of an equation's value.
+///
+/// The solver scales by it so that convergence, pivoting and the condition estimate do not depend
+/// on the length unit: lengths are divided by the scene's [`Mechanism::length_scale`], areas by
+/// its square, angles are left alone. A scene in metres and the same scene in millimetres then
+/// take the same Newton steps and report the same condition number.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Unit {
+    /// Radians (θ coordinates, angle drivers, a prismatic joint's relative angle).
+    Angle,
+    /// A length (x, y coordinates, point-coincidence equations, position drivers).
+    Length,
+    /// A length squared (a distance joint's `|d|² − L²`).
+    Area,
+}
+
+impl Unit {
+    /// The power of length this unit carries (0, 1 or 2).
+    pub fn length_power(self) -> i32 {
+        match self {
+            Self::Angle => 0,
+            Self::Length => 1,
+            Self::Area => 2,
+        }
+    }
+}
+
 /// The kinematic equations of a planar mechanism in Cartesian body coordinates.
 ///
 /// `q` holds `(x, y, θ)` for every body in declaration order; equations follow the scene's
@@ -91,6 +118,39 @@ where
     /// [`ParameterError::Unknown`] if no parameter has that name, [`ParameterError::NonFinite`] for
     /// NaN or infinite values (the mechanism is left unchanged).
     fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParameterError>;
+
+    /// Physical dimension of coordinate `index` (past the end: [`Unit::Angle`], unscaled).
+    fn coordinate_unit(&self, index: usize) -> Unit;
+
+    /// Physical dimension of equation `index` (past the end: [`Unit::Angle`], unscaled).
+    fn equation_unit(&self, index: usize) -> Unit;
+
+    /// The scene's characteristic length with the current parameters: the largest magnitude
+    /// among its geometric lengths (body-fixed points, distances, ground positions). The solver
+    /// measures lengths relative to it; it is only a scale, so any value within a few orders of
+    /// magnitude of the mechanism's size works. Zero or non-finite values make the solver fall
+    /// back to 1.
+    fn length_scale(&self) -> f64;
+
+    /// Number of branch invariants the scene declares (`branch NAME: …;` in the spec).
+    ///
+    /// A branch invariant is a quantity whose sign tells two assembly branches apart (e.g. the
+    /// cross product of two links of a loop); the solver refuses a solution where one has the
+    /// wrong sign rather than stepping silently onto the mirror branch.
+    fn branch_count(&self) -> usize {
+        0
+    }
+
+    /// Name of branch invariant `index`; `None` past the end.
+    fn branch_name(&self, _index: usize) -> Option<&str> {
+        None
+    }
+
+    /// Value of branch invariant `index` at `q`, signed so that it is positive on the declared
+    /// branch; NaN past the end.
+    fn branch_value(&self, _index: usize, _q: &Vector<Self::Dim>) -> f64 {
+        f64::NAN
+    }
 
     /// Writes the scene's initial guess (ground poses and the moving bodies' declared guesses).
     fn initial_guess(&self, q: &mut Vector<Self::Dim>);

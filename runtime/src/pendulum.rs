@@ -10,7 +10,7 @@ use crate::error::SolveError;
 use crate::lu::Lu;
 use crate::math::{cos, sin};
 use crate::mechanism::{
-    Accelerations, Matrix, Mechanism, Outputs, ParameterError, Vector, Velocities,
+    Accelerations, Matrix, Mechanism, Outputs, ParameterError, Unit, Vector, Velocities,
 };
 use crate::solver::{solve_accelerations, solve_velocities};
 
@@ -70,6 +70,19 @@ impl Mechanism for Pendulum {
     }
     fn set_parameter(&mut self, _: &str, _: f64) -> Result<(), ParameterError> {
         Err(ParameterError::Unknown)
+    }
+    fn coordinate_unit(&self, index: usize) -> Unit {
+        if index < 2 { Unit::Length } else { Unit::Angle }
+    }
+    fn equation_unit(&self, index: usize) -> Unit {
+        if index < 2 || self.duplicate_pin {
+            Unit::Length
+        } else {
+            Unit::Angle
+        }
+    }
+    fn length_scale(&self) -> f64 {
+        self.a.abs()
     }
     fn initial_guess(&self, q: &mut Vector<Const<3>>) {
         *q = Vector::from([self.a, 0.1, 0.1]);
@@ -149,8 +162,8 @@ pub struct DynPendulum(pub Pendulum);
 #[cfg(feature = "alloc")]
 mod dynamic {
     use super::{
-        Accelerations, DynPendulum, Lu, Mechanism, Outputs, ParameterError, SolveError, Vector,
-        Velocities, solve_accelerations, solve_velocities,
+        Accelerations, DynPendulum, Lu, Mechanism, Outputs, ParameterError, SolveError, Unit,
+        Vector, Velocities, solve_accelerations, solve_velocities,
     };
     use crate::mechanism::Matrix;
     use nalgebra::{Const, Dyn, Matrix3, Vector3};
@@ -182,6 +195,15 @@ mod dynamic {
         }
         fn set_parameter(&mut self, _: &str, _: f64) -> Result<(), ParameterError> {
             Err(ParameterError::Unknown)
+        }
+        fn coordinate_unit(&self, index: usize) -> Unit {
+            self.0.coordinate_unit(index)
+        }
+        fn equation_unit(&self, index: usize) -> Unit {
+            self.0.equation_unit(index)
+        }
+        fn length_scale(&self) -> f64 {
+            self.0.length_scale()
         }
         fn initial_guess(&self, q: &mut Vector<Dyn>) {
             let mut fixed_q = Vector3::zeros();

@@ -1,15 +1,28 @@
-//! Stepping a mechanism through time, warm-starting each Newton solve from a Taylor predictor.
+//! Stepping a mechanism through time: each Newton solve warm-started from a predictor, checked
+//! for a jump to another branch, and retried in sub-steps when it fails or jumps.
 
 use nalgebra::DefaultAllocator;
 
-use crate::error::SolveError;
-use crate::mechanism::{Mechanism, Outputs, Storage};
+use crate::error::{Quantity, SolveError};
+use crate::mechanism::{Mechanism, Outputs, Storage, Vector};
 use crate::solver::Solver;
 use crate::state::State;
 
+/// A predicted step is suspect when Newton moved the solution further from the prediction than
+/// this fraction of the predicted motion: a second-order prediction is O(h³) off while the
+/// motion is O(h), so only a step far too coarse for the motion, or a landing on the mirror
+/// branch, gets near it.
+const JUMP_FRACTION: f64 = 0.5;
+/// … plus this much (scaled: scene lengths, radians) and ten times the solver's tolerances, so
+/// that a mechanism at rest, whose predicted motion is zero, is not suspect for the corrections
+/// of round-off or of a loosely converged solve.
+const JUMP_FLOOR: f64 = 1e-6;
+/// Default number of times a failed step may be halved; see [`Simulation::set_max_halvings`].
+pub const DEFAULT_MAX_HALVINGS: u32 = 10;
+
 /// A solver plus the last solved state, advanced with [`Simulation::step_to`].
 ///
-/// Holds two states and swaps them, so stepping never allocates and a failed step leaves the
+/// Holds three states and swaps them, so stepping never allocates and a failed step leaves the
 /// last good state untouched.
 pub struct Simulation<M: Mechanism>
 where
@@ -19,9 +32,22 @@ where
     current: State<M>,
     /// Scratch for the next solve; after a step it holds the state before `current`.
     next: State<M>,
+    /// The state a sub-stepped step started from, restored if it fails.
+    saved: State<M>,
+    /// The last prediction, to measure how far Newton moved from it.
+    prediction: Vector<M::Dim>,
     /// Whether `next` holds a solved earlier state (for the positions-only predictor).
     has_previous: bool,
     predictor: bool,
+    max_halvings: u32,
+}
+
+/// How one predicted solve ended.
+enum Outcome {
+    Solved,
+    /// Converged, but far from the prediction: possibly on another branch.
+    Jumped,
+    Failed(SolveError),
 }
 
 impl<M: Mechanism> Simulation<M>
@@ -36,12 +62,16 @@ where
         let mut current = State::new(solver.mechanism());
         solver.mechanism().initial_guess(&mut current.q);
         solver.solve_into(t0, &mut current)?;
+        current.substeps = 1;
         Ok(Self {
             next: current.clone(),
+            saved: current.clone(),
+            prediction: current.q.clone(),
             solver,
             current,
             has_previous: false,
             predictor: true,
+            max_halvings: DEFAULT_MAX_HALVINGS,
         })
     }
 
@@ -53,6 +83,12 @@ where
     /// Whether the predictor is on.
     pub fn predictor(&self) -> bool {
         self.predictor
+    }
+
+    /// How many times a failed step may be halved (default [`DEFAULT_MAX_HALVINGS`]; 0 turns
+    /// sub-stepping off). A step of length h is never cut below h / 2^`halvings`.
+    pub fn set_max_halvings(&mut self, halvings: u32) {
+        self.max_halvings = halvings.min(60);
     }
 
     /// The last solved state.
@@ -80,12 +116,80 @@ where
     /// or, for a positions-only scene, the secant through the last two solved positions. The
     /// second-order guess is O(h³) off, so Newton typically needs one or two updates.
     ///
+    /// When that solve fails in a way a shorter step may cure (no convergence, no assembly, a
+    /// branch flip) or lands suspiciously far from the prediction (the mirror branch), the
+    /// drivers are sub-stepped: the interval is halved, and halved again on failure, down to
+    /// 2^-`max_halvings` of it, each sub-step predicted from the last. The state then records the
+    /// sub-steps taken ([`State::substeps`]) and all their Newton iterations.
+    ///
     /// # Errors
-    /// The [`SolveError`] of the solve at `t`; the simulation stays at the previous state.
+    /// The [`SolveError`] of the solve at `t`, or of the sub-step that could not be shortened
+    /// further (with its time); the simulation stays at the previous state.
     pub fn step_to(&mut self, t: f64) -> Result<&State<M>, SolveError> {
+        if !t.is_finite() {
+            return Err(SolveError::NonFinite {
+                time: t,
+                quantity: Quantity::Time,
+            });
+        }
+        match self.advance(t, false) {
+            Outcome::Solved => {}
+            Outcome::Failed(error) if !error.is_step_related() || self.max_halvings == 0 => {
+                return Err(error);
+            }
+            Outcome::Jumped if self.max_halvings == 0 => self.accept(),
+            Outcome::Failed(_) | Outcome::Jumped => return self.substep(t),
+        }
+        self.current.substeps = 1;
+        Ok(&self.current)
+    }
+
+    /// Reaches `t_end` in sub-steps from `current`; see [`Simulation::step_to`].
+    fn substep(&mut self, t_end: f64) -> Result<&State<M>, SolveError> {
+        self.saved.copy_from(&self.current);
+        let t_start = self.current.t;
+        let shortest = (t_end - t_start).abs() / (1_u64 << self.max_halvings) as f64;
+        let mut h = 0.5 * (t_end - t_start);
+        let (mut substeps, mut iterations, mut successes) = (0, 0, 0);
+        loop {
+            let remaining = t_end - self.current.t;
+            if remaining == 0.0 {
+                self.current.substeps = substeps;
+                self.current.iterations = iterations;
+                return Ok(&self.current);
+            }
+            // Within a hair of the end, take the end exactly rather than leave a sliver.
+            let target = if remaining.abs() <= 1.000_001 * h.abs() {
+                t_end
+            } else {
+                self.current.t + h
+            };
+            // At the shortest sub-step a jump is accepted: continuation from the last state is
+            // as close to the motion as stepping can get (declared branches are still checked).
+            let finest = 0.5 * h.abs() < shortest;
+            match self.advance(target, finest) {
+                Outcome::Solved => {
+                    (substeps, iterations) = (substeps + 1, iterations + self.current.iterations);
+                    successes += 1;
+                    // Two good sub-steps in a row: try a longer one (never beyond half the step).
+                    if successes >= 2 && 2.0 * h.abs() <= 0.5 * (t_end - t_start).abs() {
+                        (h, successes) = (2.0 * h, 0);
+                    }
+                }
+                Outcome::Failed(error) if !error.is_step_related() || finest => {
+                    self.current.copy_from(&self.saved);
+                    return Err(error);
+                }
+                Outcome::Failed(_) | Outcome::Jumped => (h, successes) = (0.5 * h, 0),
+            }
+        }
+    }
+
+    /// One predicted solve at `t` into `next`; on success `next` becomes `current`, except for
+    /// a suspected jump, which is left unaccepted unless `accept_jump`.
+    fn advance(&mut self, t: f64, accept_jump: bool) -> Outcome {
         let (current, next) = (&self.current, &mut self.next);
         let h = t - current.t;
-        let predict = self.predictor && h.is_finite();
         let (q, qd, qdd) = (
             current.q.as_slice(),
             current.velocities.as_slice(),
@@ -96,19 +200,41 @@ where
         let h_prev = current.t - next.t;
         let secant = self.has_previous && h_prev != 0.0 && h_prev.is_finite();
         let outputs = current.outputs();
+        let predicted = self.predictor
+            && match outputs {
+                Outputs::Positions => secant,
+                Outputs::Velocities | Outputs::Accelerations => true,
+            };
         for (k, guess) in next.q.as_mut_slice().iter_mut().enumerate() {
             *guess = match outputs {
-                _ if !predict => q[k],
+                _ if !predicted => q[k],
                 Outputs::Accelerations => q[k] + h * qd[k] + 0.5 * h * h * qdd[k],
                 Outputs::Velocities => q[k] + h * qd[k],
-                Outputs::Positions if secant => q[k] + (q[k] - *guess) * (h / h_prev),
-                Outputs::Positions => q[k],
+                Outputs::Positions => q[k] + (q[k] - *guess) * (h / h_prev),
             };
         }
-        self.solver.solve_into(t, next)?;
+        let motion = self.solver.scaled_distance(&next.q, &current.q);
+        self.prediction.copy_from(&next.q);
+        // From here `next` no longer holds the previous state, whatever the outcome.
+        self.has_previous = false;
+        if let Err(error) = self.solver.solve_into(t, &mut self.next) {
+            return Outcome::Failed(error);
+        }
+        if predicted && !accept_jump {
+            let correction = self.solver.scaled_distance(&self.next.q, &self.prediction);
+            let options = self.solver.options();
+            let floor = JUMP_FLOOR + 10.0 * (options.residual_tolerance + options.step_tolerance);
+            if correction > JUMP_FRACTION * motion + floor {
+                return Outcome::Jumped;
+            }
+        }
+        self.accept();
+        Outcome::Solved
+    }
+
+    fn accept(&mut self) {
         core::mem::swap(&mut self.current, &mut self.next);
         self.has_previous = true;
-        Ok(&self.current)
     }
 
     /// Calls `visit` with the current state, then steps `steps` times to `t_end` in equal steps,

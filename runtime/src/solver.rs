@@ -1,29 +1,45 @@
-//! Newton–Raphson positions and linear velocity/acceleration solves, sharing one workspace.
+//! The solver: its options, its workspace, unit scaling, and the linear velocity and
+//! acceleration solves. The position solve (Newton–Raphson with its safeguards) is in
+//! `position.rs`.
 
 use nalgebra::{DefaultAllocator, Dim, U1};
 
-use crate::error::{Quantity, SolveError};
+use crate::error::{Described, Quantity, SolveError};
 use crate::lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
-use crate::mechanism::{Accelerations, Mechanism, Outputs, Storage, Vector, Velocities};
+use crate::mechanism::{Accelerations, Matrix, Mechanism, Storage, Vector, Velocities};
 use crate::state::State;
 
-/// Tolerances of the position solve and the factorisation.
+/// Tolerances and safeguards of the position solve.
 ///
-/// Tolerances are relative to `max(1, ‖q‖∞)`, so they act as absolute tolerances for small
-/// mechanisms and relative ones for large coordinates. Angles and lengths share the scale for
-/// now; unit-aware scaling is left to the stability work.
+/// Tolerances apply to the unit-scaled system (see [`crate::Unit`]): lengths are measured in
+/// units of the scene's [`Mechanism::length_scale`], angles in radians. The same options then
+/// suit a micro-mechanism in metres and an engine in millimetres.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverOptions {
-    /// Converged when ‖Φ‖∞ ≤ `residual_tolerance · max(1, ‖q‖∞)` … (default 1e-10)
+    /// Converged when the scaled residual ‖D_r Φ‖∞ ≤ `residual_tolerance` … (default 1e-10)
     pub residual_tolerance: f64,
-    /// … and the Newton step taken from there has ‖Δq‖∞ ≤ `step_tolerance · max(1, ‖q‖∞)`
-    /// (default 1e-10).
+    /// … and the scaled Newton step taken from there is ≤ `step_tolerance` (default 1e-10).
     pub step_tolerance: f64,
-    /// Newton updates allowed before [`SolveError::NoConvergence`] (default 25).
+    /// Updates (Newton, damped or Levenberg–Marquardt) before giving up (default 50).
     pub max_iterations: usize,
-    /// Relative pivot tolerance; see [`Lu::set_pivot_tolerance`] (default
+    /// Relative pivot tolerance of the scaled Φ_q; see [`Lu::set_pivot_tolerance`] (default
     /// [`DEFAULT_PIVOT_TOLERANCE`]).
     pub pivot_tolerance: f64,
+    /// Largest condition estimate of the scaled Φ_q accepted at a solution (default 1e10).
+    ///
+    /// Velocities and accelerations lose about log₁₀(κ) digits, so 1e10 still leaves six; above
+    /// it the solve fails with [`SolveError::Singular`] rather than return digits of noise.
+    pub max_condition: f64,
+    /// Largest scaled Newton step (default 1): a step is shortened to move no coordinate by
+    /// more than this many scene lengths or radians, so a bad guess cannot throw the iterate
+    /// across the mechanism.
+    pub max_step: f64,
+    /// Scale equations and coordinates by their units (default true). Off, tolerances and the
+    /// condition estimate apply to raw values: only for measuring what scaling costs.
+    pub scale_units: bool,
+    /// Estimate the condition of Φ_q at every solution (default true). Off, `max_condition` is
+    /// not checked and states report a NaN condition: only for measuring what the estimate costs.
+    pub estimate_condition: bool,
 }
 
 impl Default for SolverOptions {
@@ -31,8 +47,12 @@ impl Default for SolverOptions {
         Self {
             residual_tolerance: 1e-10,
             step_tolerance: 1e-10,
-            max_iterations: 25,
+            max_iterations: 50,
             pivot_tolerance: DEFAULT_PIVOT_TOLERANCE,
+            max_condition: 1e10,
+            max_step: 1.0,
+            scale_units: true,
+            estimate_condition: true,
         }
     }
 }
@@ -40,27 +60,40 @@ impl Default for SolverOptions {
 /// Outcome of a successful position solve.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Convergence {
-    /// Newton updates applied (at least 1: the step that confirmed convergence is applied too).
+    /// Updates applied (at least 1: the step that confirmed convergence is applied too).
     pub iterations: usize,
-    /// ‖Φ‖∞ at the returned positions.
+    /// ‖Φ‖∞ at the returned positions (unscaled).
     pub residual: f64,
-    /// [`Lu::rough_condition`] of Φ_q at the returned positions.
+    /// Condition estimate κ₁ of the scaled Φ_q at the returned positions (NaN if switched off).
     pub condition: f64,
 }
 
 /// Kinematic solver owning a mechanism and every buffer it needs.
 ///
-/// All storage is created by [`Solver::new`]; solves never allocate.
+/// All storage is created by [`Solver::new`]; solves never allocate, error paths included.
 pub struct Solver<M: Mechanism>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
-    mechanism: M,
-    options: SolverOptions,
-    /// Φ, then reused in place for the Newton step.
-    phi: Vector<M::Dim>,
-    /// Factors of Φ_q at the last positions it was evaluated at.
-    lu: Lu<M::Dim>,
+    pub(crate) mechanism: M,
+    pub(crate) options: SolverOptions,
+    /// Φ at the current iterate.
+    pub(crate) phi: Vector<M::Dim>,
+    /// The last step (Φ_q⁻¹ Φ, i.e. −Δq at full length), or a Levenberg–Marquardt step.
+    pub(crate) step: Vector<M::Dim>,
+    /// The iterate the last step was taken from, for backtracking.
+    pub(crate) base: Vector<M::Dim>,
+    /// Scratch: Φ at a trial point; J_sᵀ Φ_s in Levenberg–Marquardt.
+    pub(crate) trial: Vector<M::Dim>,
+    pub(crate) gradient: Vector<M::Dim>,
+    /// Unit scales: D_r (per equation, 1/L^p) and D_c (per coordinate, L^p).
+    pub(crate) rows: Vector<M::Dim>,
+    pub(crate) cols: Vector<M::Dim>,
+    /// The scaled Φ_q for Levenberg–Marquardt steps (the LU storage then holds J_sᵀJ_s + μI).
+    pub(crate) jacobian: Matrix<M::Dim>,
+    /// Factors of the scaled Φ_q at the last positions it was evaluated at, or after a
+    /// [`SolveError::Singular`], the rank-revealing diagnosis.
+    pub(crate) lu: Lu<M::Dim>,
 }
 
 impl<M: Mechanism> Solver<M>
@@ -77,10 +110,18 @@ where
         let dim = mechanism.dim();
         let mut lu = Lu::new(dim);
         lu.set_pivot_tolerance(options.pivot_tolerance);
+        let zeros = Vector::zeros_generic(dim, U1);
         Self {
             mechanism,
             options,
-            phi: Vector::zeros_generic(dim, U1),
+            phi: zeros.clone(),
+            step: zeros.clone(),
+            base: zeros.clone(),
+            trial: zeros.clone(),
+            gradient: zeros.clone(),
+            rows: Vector::from_element_generic(dim, U1, 1.0),
+            cols: Vector::from_element_generic(dim, U1, 1.0),
+            jacobian: Matrix::zeros_generic(dim, dim),
             lu,
         }
     }
@@ -111,79 +152,39 @@ where
         self.lu.set_pivot_tolerance(options.pivot_tolerance);
     }
 
-    /// The factorisation of Φ_q from the last solve (for its condition estimate).
+    /// The factorisation of the scaled Φ_q from the last solve.
     pub fn lu(&self) -> &Lu<M::Dim> {
         &self.lu
     }
 
-    /// Newton–Raphson on Φ(q, t) = 0, starting from and overwriting `q`.
-    ///
-    /// Each iteration evaluates Φ and Φ_q at `q`, factors Φ_q and applies the step Δq. Once a
-    /// step within `step_tolerance` has been applied from a point whose residual was within
-    /// `residual_tolerance`, Φ and Φ_q are evaluated and factored once more at the final `q`:
-    /// the reported residual is the true one there, the factors the solver keeps are exactly
-    /// those of Φ_q(q) (for [`Solver::solve_into`]), and that last step having been applied
-    /// leaves `q` quadratically (not merely to within the step tolerance) accurate.
-    ///
-    /// # Errors
-    /// [`SolveError::NonFinite`] for a non-finite `t`, guess, Φ, Φ_q or step;
-    /// [`SolveError::Singular`] when Φ_q has no usable pivot at an iterate;
-    /// [`SolveError::NoConvergence`] after `max_iterations` updates. `q` holds the last iterate.
-    pub fn solve_position(
-        &mut self,
-        q: &mut Vector<M::Dim>,
-        t: f64,
-    ) -> Result<Convergence, SolveError> {
-        self.check_inputs(t, q, Quantity::Guess)?;
-        let Self {
-            mechanism,
-            options,
-            phi,
-            lu,
-        } = self;
-        let (mut iterations, mut converged) = (0, false);
-        loop {
-            let factored =
-                lu.factor_with(|jacobian| mechanism.phi_and_jacobian(q, t, phi, jacobian));
-            check_finite(phi, t, Quantity::Phi)?;
-            factored.map_err(|error| lu_error(error, t))?;
-            let residual = max_abs(phi);
-            if converged {
-                return Ok(Convergence {
-                    iterations,
-                    residual,
-                    condition: lu.rough_condition().unwrap_or(f64::INFINITY),
-                });
-            }
-            if iterations >= options.max_iterations {
-                return Err(SolveError::NoConvergence {
-                    time: t,
-                    iterations,
-                    residual,
-                });
-            }
+    /// After a [`SolveError::Singular`]: every dependent (redundant) equation, ascending.
+    /// Empty otherwise.
+    pub fn dependent_equations(&self) -> &[usize] {
+        self.lu.dependent_rows()
+    }
 
-            lu.solve_in_place(phi).map_err(|error| lu_error(error, t))?;
-            // `phi` now holds Φ_q⁻¹ Φ = −Δq.
-            let step = max_abs(phi);
-            if !step.is_finite() {
-                return Err(non_finite(t, Quantity::Step));
-            }
-            let scale = max_abs(q).max(1.0);
-            converged = residual <= options.residual_tolerance * scale
-                && step <= options.step_tolerance * scale;
-            *q -= &*phi;
-            iterations += 1;
-            // A positions-only scene needs no factors at the returned q (nothing solves with
-            // them): stop without the confirming evaluation; `residual` is then the one before
-            // the last (tiny) step, an upper bound.
-            if converged && mechanism.outputs() == Outputs::Positions {
-                return Ok(Convergence {
-                    iterations,
-                    residual,
-                    condition: lu.rough_condition().unwrap_or(f64::INFINITY),
-                });
-            }
+    /// After a [`SolveError::Singular`]: every coordinate the equations leave undetermined.
+    pub fn undetermined_coordinates(&self) -> &[usize] {
+        self.lu.undetermined_columns()
+    }
+
+    /// Displays `error` with the scene's names and, for the [`SolveError::Singular`] this
+    /// solver just returned, every dependent equation and undetermined coordinate.
+    pub fn describe<'a>(&'a self, error: &'a SolveError) -> Described<'a, M> {
+        let singular = matches!(error, SolveError::Singular { .. });
+        Described {
+            error,
+            mechanism: &self.mechanism,
+            dependent: if singular {
+                self.dependent_equations()
+            } else {
+                &[]
+            },
+            undetermined: if singular {
+                self.undetermined_coordinates()
+            } else {
+                &[]
+            },
         }
     }
 
@@ -223,18 +224,70 @@ where
         )?;
         state.t = t;
         state.iterations = convergence.iterations;
+        state.condition = convergence.condition;
         Ok(())
     }
 
+    /// Evaluates and factors the scaled Φ_q at `q` for a separate derivative solve.
     fn factor_jacobian(&mut self, q: &Vector<M::Dim>, t: f64) -> Result<(), SolveError> {
-        let mechanism = &self.mechanism;
-        self.lu
-            .factor_with(|jacobian| mechanism.jacobian(q, t, jacobian))
+        self.check_parameters(t)?;
+        self.update_scales();
+        let Self {
+            mechanism,
+            lu,
+            rows,
+            cols,
+            ..
+        } = self;
+        lu.factor_scaled_with(rows, cols, |jacobian| mechanism.jacobian(q, t, jacobian))
             .map_err(|error| lu_error(error, t))
     }
 
+    /// ‖D_c⁻¹ (a − b)‖∞: how far apart two configurations are, in scene lengths and radians
+    /// (with the scales of the last solve).
+    pub fn scaled_distance(&self, a: &Vector<M::Dim>, b: &Vector<M::Dim>) -> f64 {
+        let (a, b, cols) = (a.as_slice(), b.as_slice(), self.cols.as_slice());
+        a.iter()
+            .zip(b)
+            .zip(cols)
+            .fold(0.0, |m, ((x, y), c)| m.max(((x - y) / c).abs()))
+    }
+
+    /// Every parameter finite: a NaN set through a public field is reported as itself, not as
+    /// the NaN Φ it would cause.
+    pub(crate) fn check_parameters(&self, t: f64) -> Result<(), SolveError> {
+        let m = &self.mechanism;
+        match (0..m.parameter_count()).find(|&i| !m.parameter(i).is_some_and(f64::is_finite)) {
+            Some(index) => Err(non_finite(t, Quantity::Parameter(index))),
+            None => Ok(()),
+        }
+    }
+
+    /// Recomputes the unit scales from the current parameters: D_r = 1/L^p per equation,
+    /// D_c = L^p per coordinate, with L the scene's length scale rounded to a power of two so
+    /// that scaling adds no rounding error.
+    pub(crate) fn update_scales(&mut self) {
+        let length = if self.options.scale_units {
+            power_of_two(self.mechanism.length_scale())
+        } else {
+            1.0
+        };
+        let m = &self.mechanism;
+        let scale = |power: i32| match power {
+            0 => 1.0,
+            1 => length,
+            _ => length * length,
+        };
+        for (i, r) in self.rows.as_mut_slice().iter_mut().enumerate() {
+            *r = 1.0 / scale(m.equation_unit(i).length_power());
+        }
+        for (j, c) in self.cols.as_mut_slice().iter_mut().enumerate() {
+            *c = scale(m.coordinate_unit(j).length_power());
+        }
+    }
+
     /// Length and finiteness of an input, and finiteness of `t`.
-    fn check_inputs(
+    pub(crate) fn check_inputs(
         &self,
         t: f64,
         v: &Vector<M::Dim>,
@@ -248,7 +301,7 @@ where
     }
 
     /// Only a `Dyn` vector can disagree with the workspace; nalgebra would panic on it.
-    fn check_len(&self, v: &Vector<M::Dim>) -> Result<(), SolveError> {
+    pub(crate) fn check_len(&self, v: &Vector<M::Dim>) -> Result<(), SolveError> {
         let expected = self.phi.nrows();
         if v.nrows() == expected && self.mechanism.dim().value() == expected {
             Ok(())
@@ -259,6 +312,17 @@ where
             })
         }
     }
+}
+
+/// The power of two nearest below `length` (1 for zero, subnormal or non-finite lengths, or
+/// ones so extreme that their square would overflow the scaled equations).
+fn power_of_two(length: f64) -> f64 {
+    let length = length.abs();
+    if !(1e-100..=1e100).contains(&length) {
+        return 1.0;
+    }
+    // Clearing the mantissa of a normal positive float leaves its power of two.
+    f64::from_bits(length.to_bits() & 0xfff0_0000_0000_0000)
 }
 
 impl<M: Velocities> Solver<M>
@@ -349,18 +413,22 @@ where
 }
 
 /// ‖v‖∞ over the contiguous storage (nalgebra's `amax` iterates element by element, slowly).
-fn max_abs<D: Dim>(v: &Vector<D>) -> f64
+pub(crate) fn max_abs<D: Dim>(v: &Vector<D>) -> f64
 where
     DefaultAllocator: Storage<D>,
 {
     v.as_slice().iter().fold(0.0, |m, x| m.max(x.abs()))
 }
 
-fn non_finite(time: f64, quantity: Quantity) -> SolveError {
+pub(crate) fn non_finite(time: f64, quantity: Quantity) -> SolveError {
     SolveError::NonFinite { time, quantity }
 }
 
-fn check_finite<D: Dim>(v: &Vector<D>, t: f64, quantity: Quantity) -> Result<(), SolveError>
+pub(crate) fn check_finite<D: Dim>(
+    v: &Vector<D>,
+    t: f64,
+    quantity: Quantity,
+) -> Result<(), SolveError>
 where
     DefaultAllocator: Storage<D>,
 {
@@ -371,13 +439,14 @@ where
     }
 }
 
-fn lu_error(error: LuError, time: f64) -> SolveError {
+pub(crate) fn lu_error(error: LuError, time: f64) -> SolveError {
     match error {
-        LuError::Singular { row, column, pivot } => SolveError::Singular {
+        LuError::Singular { row, column, .. } => SolveError::Singular {
             time,
             equation: row,
             coordinate: column,
-            pivot,
+            condition: f64::INFINITY,
+            deficiency: 1,
         },
         LuError::NonFinite => non_finite(time, Quantity::Jacobian),
         // The solver checks sizes and factors before every solve; map rather than panic.
@@ -419,6 +488,45 @@ mod tests {
         let convergence = solver.solve_position(&mut q, 0.7).unwrap();
         assert_eq!(convergence.iterations, 1);
         assert!(convergence.residual <= 1e-15);
+    }
+
+    #[test]
+    fn newton_takes_the_same_steps_at_any_length_scale() {
+        let solve = |a: f64| {
+            let mut solver = Solver::new(Pendulum {
+                a,
+                ..Pendulum::default()
+            });
+            let mut q = Vector::from([0.9 * a, 0.3 * a, 0.4]);
+            let convergence = solver.solve_position(&mut q, 0.7).unwrap();
+            (convergence.iterations, q[2], convergence.condition)
+        };
+        let reference = solve(2.0);
+        // Scaled by a power of two, the scaled problem is the same to the bit.
+        for a in [2.0 * 2f64.powi(-20), 2.0 * 2f64.powi(14)] {
+            assert_eq!(solve(a), reference, "a = {a}");
+        }
+        // Otherwise the scale is rounded to a power of two, which leaves the scaled entries
+        // within a factor of two of these: the same iterations and solution.
+        for a in [2e-6, 2e4] {
+            let (iterations, theta, _) = solve(a);
+            assert_eq!(iterations, reference.0, "a = {a}");
+            assert!((theta - reference.1).abs() < 1e-14, "a = {a}");
+        }
+    }
+
+    #[test]
+    fn a_guess_half_a_turn_away_still_converges() {
+        let mut solver = Solver::new(Pendulum::default());
+        // The rod guessed pointing the other way, its angle 3 rad off: steps are clamped and
+        // damped rather than thrown across the plane.
+        let mut q = Vector::from([-2.0, 0.0, 0.7 + 3.0]);
+        let convergence = solver.solve_position(&mut q, 0.7 / 1.5).unwrap();
+        let exact = Pendulum::default().exact(0.7 / 1.5);
+        assert!(
+            (q[0] - exact[0][0]).abs() < 1e-12,
+            "{q:?} after {convergence:?}"
+        );
     }
 
     #[test]

@@ -25,8 +25,14 @@ where
     pub(crate) velocities: Vector<M::Dim>,
     /// Accelerations q̈ (zero unless the scene computes them).
     pub(crate) accelerations: Vector<M::Dim>,
-    /// Newton updates the position solve needed.
+    /// Newton updates the position solve needed (summed over sub-steps, if any).
     pub iterations: usize,
+    /// Time steps this state took: 1, or more when [`crate::Simulation`] had to sub-step the
+    /// drivers to get here (0 for a state not reached by stepping).
+    pub substeps: usize,
+    /// Condition estimate κ₁ of the unit-scaled Φ_q at `q` (see [`crate::Lu::condition_estimate`]);
+    /// large near toggle positions. NaN when the solver's estimate is switched off.
+    pub condition: f64,
     /// What the scene computes, which decides the CSV columns.
     outputs: Outputs,
     // `fn() -> M` keeps `State` Send/Sync/Clone regardless of `M`.
@@ -108,9 +114,22 @@ where
             velocities: Vector::zeros_generic(dim, nalgebra::U1),
             accelerations: Vector::zeros_generic(dim, nalgebra::U1),
             iterations: 0,
+            substeps: 0,
+            condition: f64::NAN,
             outputs: mechanism.outputs(),
             mechanism: PhantomData,
         }
+    }
+
+    /// Copies `other` into `self` without allocating (both hold vectors of the same length).
+    pub(crate) fn copy_from(&mut self, other: &Self) {
+        self.t = other.t;
+        self.q.copy_from(&other.q);
+        self.velocities.copy_from(&other.velocities);
+        self.accelerations.copy_from(&other.accelerations);
+        self.iterations = other.iterations;
+        self.substeps = other.substeps;
+        self.condition = other.condition;
     }
 
     /// The outputs this state holds (its scene's).
@@ -242,6 +261,8 @@ where
             velocities: self.velocities.clone(),
             accelerations: self.accelerations.clone(),
             iterations: self.iterations,
+            substeps: self.substeps,
+            condition: self.condition,
             outputs: self.outputs,
             mechanism: PhantomData,
         }
@@ -259,6 +280,8 @@ where
             .field("qd", &self.velocities.as_slice())
             .field("qdd", &self.accelerations.as_slice())
             .field("iterations", &self.iterations)
+            .field("substeps", &self.substeps)
+            .field("condition", &self.condition)
             .field("outputs", &self.outputs)
             .finish()
     }

@@ -106,7 +106,9 @@ fn singular_configuration_is_described_by_name() {
     let equation = solver.mechanism().equation_name(equation).unwrap();
     let coordinate = solver.mechanism().coordinate_name(coordinate).unwrap();
     assert!(
-        described.contains(&format!("equation {equation} / coordinate {coordinate}")),
+        described.contains(&format!(
+            "equation `{equation}` leaves coordinate `{coordinate}` undetermined"
+        )),
         "{described}"
     );
     assert!(!described.contains('#'), "{described}");

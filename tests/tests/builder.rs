@@ -12,7 +12,7 @@ mod geometry;
 mod scene;
 
 use mechgen::CodegenOptions;
-use mechgen::builder::SceneBuilder;
+use mechgen::builder::{Product, SceneBuilder, Sign};
 use mechgen_cli::Interpreted;
 use mechgen_runtime::{Mechanism, Solver};
 
@@ -43,6 +43,17 @@ fn the_seed_built_in_code_generates_the_same_code_as_its_file() {
     seed.revolute("main_bearing", "crank", "bearing");
     seed.prismatic("slide", "liner", "piston", [1.0, 0.0]);
     seed.driver_angle("crank_angle", "crank", "omega * t");
+    seed.branch(
+        "piston_outboard",
+        Product::Dot,
+        ("bearing", "liner"),
+        (("rod", [41.3, 0.0]), ("rod", [0.0, 102.6])),
+        Sign::Positive,
+    )
+    .item_doc(
+        "The piston stays on the liner's side of the crank pin: the rod, from crank pin to piston",
+    )
+    .item_doc("pin, points along the cylinder axis (bearing to liner).");
 
     let options = CodegenOptions::default();
     let built = seed.expand(&options).unwrap_or_else(|e| panic!("{e}"));

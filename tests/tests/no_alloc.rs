@@ -1,5 +1,6 @@
 //! Generated code through the runtime allocates nothing: positions, velocities and
-//! accelerations of the seed over many steps, an error path, and CSV output.
+//! accelerations of the seed over many steps, sub-stepping, every error path with its
+//! description, and CSV output.
 //!
 //! A counting global allocator wraps the system one. This file holds a single test so that no
 //! other test thread allocates while it counts.
@@ -11,7 +12,10 @@ use core::sync::atomic::{AtomicUsize, Ordering};
 use std::alloc::System;
 
 use mechgen_examples::scenes::{FourBar, PistonCrank, PistonCrankBodies};
-use mechgen_runtime::{Simulation, Solver};
+use mechgen_examples::stability::{
+    self, FlexiblePistonCrank, Parallelogram, SliderCrank, Unclosable,
+};
+use mechgen_runtime::{Mechanism, Simulation, SolveError, Solver};
 
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
 
@@ -93,6 +97,49 @@ fn generated_scenes_solve_without_allocating() {
 
     let mut four_bar = Simulation::new(Solver::new(FourBar::default()), 0.0).expect("four-bar");
     four_bar.run(1.0, 1_000, |_| {}).expect("four-bar solves");
+
+    // Every safeguard and failure of the stability work: sub-stepping a coarse step, the
+    // Levenberg–Marquardt fallback ending in NoAssembly, the rank-revealing diagnosis of a
+    // toggle and of redundant constraints, a branch flip from a bad guess, a NaN parameter.
+    let oscillating = FlexiblePistonCrank {
+        omega: 0.0,
+        amplitude: 0.5,
+        frequency: 2000.0,
+        ..FlexiblePistonCrank::default()
+    };
+    let mut coarse = Simulation::new(Solver::new(oscillating), 0.0).expect("oscillating seed");
+    let mut substeps = 0;
+    coarse
+        .run(core::f64::consts::TAU / 2000.0, 6, |state| {
+            substeps += state.substeps;
+        })
+        .expect("sub-steps through");
+    assert!(substeps > 7, "{substeps}");
+    let unclosable = Simulation::new(Solver::new(Unclosable::default()), 0.0);
+    assert!(matches!(
+        unclosable.err(),
+        Some(SolveError::NoAssembly { .. })
+    ));
+    let mut toggle = Simulation::new(
+        Solver::new(SliderCrank {
+            l: 1.0,
+            ..SliderCrank::default()
+        }),
+        0.0,
+    )
+    .expect("slider-crank");
+    let error = toggle.run(core::f64::consts::TAU, 97, |_| {}).unwrap_err();
+    write!(sink, "{}", toggle.solver().describe(&error)).expect("sink never fails");
+    let mut solver = Solver::new(Parallelogram::default());
+    let mut q = Default::default();
+    solver.mechanism().initial_guess(&mut q);
+    let error = solver.solve_position(&mut q, 0.0).unwrap_err();
+    write!(sink, "{}", solver.describe(&error)).expect("sink never fails");
+    assert!(matches!(error, SolveError::Singular { .. }));
+    assert!(stability::seed_from_origin(0.0).is_err());
+    let mut nan = Solver::new(FlexiblePistonCrank::default());
+    nan.mechanism_mut().omega = f64::NAN;
+    assert!(nan.solve_position(&mut Default::default(), 0.0).is_err());
     let allocations = ALLOCATIONS.load(Ordering::SeqCst) - before;
 
     assert_eq!(allocations, 0, "heap allocations in solve paths");

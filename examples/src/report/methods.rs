@@ -19,8 +19,8 @@ use mechgen::expr::Func;
 use mechgen::interpret::{Inputs, Scalar, Tape};
 use mechgen_runtime::nalgebra::{DefaultAllocator, Dim, U1};
 use mechgen_runtime::{
-    Accelerations, Lu, Matrix, Mechanism, Outputs, ParameterError, SolveError, Storage, Vector,
-    Velocities,
+    Accelerations, Lu, Matrix, Mechanism, Outputs, ParameterError, SolveError, Storage, Unit,
+    Vector, Velocities,
 };
 use num_dual::{Dual64, DualNum};
 
@@ -155,6 +155,30 @@ macro_rules! delegate_to_inner {
 
         fn parameter(&self, index: usize) -> Option<f64> {
             self.inner.parameter(index)
+        }
+
+        fn coordinate_unit(&self, index: usize) -> Unit {
+            self.inner.coordinate_unit(index)
+        }
+
+        fn equation_unit(&self, index: usize) -> Unit {
+            self.inner.equation_unit(index)
+        }
+
+        fn length_scale(&self) -> f64 {
+            self.inner.length_scale()
+        }
+
+        fn branch_count(&self) -> usize {
+            self.inner.branch_count()
+        }
+
+        fn branch_name(&self, index: usize) -> Option<&str> {
+            self.inner.branch_name(index)
+        }
+
+        fn branch_value(&self, index: usize, q: &Vector<M::Dim>) -> f64 {
+            self.inner.branch_value(index, q)
         }
 
         fn initial_guess(&self, q: &mut Vector<M::Dim>) {

@@ -7,8 +7,8 @@
 use mechgen_runtime::math::{cos, sin};
 use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{
-    Accelerations, Lu, Matrix, Mechanism, Outputs, ParameterError, SolveError, Vector, Velocities,
-    solve_accelerations, solve_velocities,
+    Accelerations, Lu, Matrix, Mechanism, Outputs, ParameterError, SolveError, Unit, Vector,
+    Velocities, solve_accelerations, solve_velocities,
 };
 
 pub type Q = Vector<Const<9>>;
@@ -130,6 +130,26 @@ impl Mechanism for SliderCrank {
         }
         self.parameters[index] = value;
         Ok(())
+    }
+
+    fn coordinate_unit(&self, index: usize) -> Unit {
+        if index % 3 == 2 {
+            Unit::Angle
+        } else {
+            Unit::Length
+        }
+    }
+
+    fn equation_unit(&self, index: usize) -> Unit {
+        if index == 2 || index == 8 {
+            Unit::Angle
+        } else {
+            Unit::Length
+        }
+    }
+
+    fn length_scale(&self) -> f64 {
+        self.parameters[0].abs().max(self.parameters[1].abs())
     }
 
     fn initial_guess(&self, q: &mut Q) {

@@ -1,0 +1,22 @@
+//! A branch invariant naming an unknown body (`slidr`, meant `slider`); the error points at
+//! it and suggests the declared body.
+use mechgen_runtime::mechanism;
+
+mechanism! {
+    mechanism SliderCrank {
+        param omega = 10.0;
+        ground frame at (0, 0, 0);
+        body crank near (0, 0, 0);
+        body rod near (1, 0, 0);
+        body slider near (3, 0, 0);
+        joint pivot: revolute(frame, crank);
+        joint crank_pin: revolute(crank @ (1, 0), rod);
+        joint wrist_pin: revolute(rod @ (2, 0), slider);
+        joint slide: prismatic(frame, slider, along (1, 0));
+        driver spin: angle(crank) = omega * t;
+
+        branch outboard: dot(frame -> slidr, crank -> rod @ (2, 0)) > 0;
+    }
+}
+
+fn main() {}
