@@ -77,7 +77,10 @@ where
             let factored = self.evaluate(q, t);
             check_finite(&self.phi, t, Quantity::Phi)?;
             let (merit, residual) = scaled_norms(&self.phi, &self.rows);
-            let small = residual <= options.residual_tolerance;
+            // Relative to the scaled coordinates' size as well: a crank that has turned for
+            // hours has θ ~ 1e6 rad, which no absolute angle tolerance near ε could resolve.
+            let magnitude = scaled_max(q, &self.cols).max(1.0);
+            let small = residual <= options.residual_tolerance * magnitude;
 
             if let Some((base_merit, fraction)) = pending.take() {
                 let enough = merit <= (1.0 - SUFFICIENT_DECREASE * fraction) * base_merit;
@@ -121,7 +124,7 @@ where
             if !length.is_finite() {
                 return Err(non_finite(t, Quantity::Step));
             }
-            converged = small && length <= options.step_tolerance;
+            converged = small && length <= options.step_tolerance * magnitude;
             let fraction = if length > options.max_step {
                 options.max_step / length
             } else {

@@ -12,11 +12,14 @@ use crate::state::State;
 /// Tolerances and safeguards of the position solve.
 ///
 /// Tolerances apply to the unit-scaled system (see [`crate::Unit`]): lengths are measured in
-/// units of the scene's [`Mechanism::length_scale`], angles in radians. The same options then
-/// suit a micro-mechanism in metres and an engine in millimetres.
+/// units of the scene's [`Mechanism::length_scale`], angles in radians, and both relative to
+/// `max(1, ‖D_c⁻¹ q‖∞)` (so a crank that has turned a million radians is still resolved to
+/// round-off). The same options then suit a micro-mechanism in metres and an engine in
+/// millimetres.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverOptions {
-    /// Converged when the scaled residual ‖D_r Φ‖∞ ≤ `residual_tolerance` … (default 1e-10)
+    /// Converged when the scaled residual ‖D_r Φ‖∞ ≤ `residual_tolerance` … (default 1e-10;
+    /// times `max(1, ‖D_c⁻¹ q‖∞)`)
     pub residual_tolerance: f64,
     /// … and the scaled Newton step taken from there is ≤ `step_tolerance` (default 1e-10).
     pub step_tolerance: f64,

@@ -79,14 +79,16 @@ fn quick_report_writes_files_consistent_with_the_closed_form() {
             let error = scene.at_reference(method).expect("ran").errors.max();
             assert!(error <= 1e-10, "{} {method}: {error:e}", scene.slug);
         }
-        // Finite differences never beat the analytic Jacobian at the same setting, and
-        // forward differences lose about half the digits in q̇ and q̈.
+        // Finite differences never beat the analytic Jacobian at the same setting (at loose
+        // tolerances both errors are the same Newton truncation, equal to a few digits: only a
+        // clear win would be wrong), and forward differences lose about half the digits in q̇
+        // and q̈.
         for setting in &settings {
             let analytic = scene.measured(Method::Generated, setting).expect("ran");
             for method in [Method::ForwardDifference, Method::CentralDifference] {
                 let fd = scene.measured(method, setting).expect("ran");
                 assert!(
-                    fd.errors.max() >= analytic.errors.max(),
+                    fd.errors.max() >= analytic.errors.max() * (1.0 - 1e-3),
                     "{} {method} {setting}: {:e} < {:e}",
                     scene.slug,
                     fd.errors.max(),
