@@ -8,7 +8,7 @@ use mechgen_runtime::{Simulation, Solver, mechanism, write_csv_header};
 
 // Generated code, not a hand-written mechanism: this proves that what `mechanism!` emits (math
 // shim, fixed-size storage, no std paths) links without std or alloc. The scene uses every joint
-// kind and a time-varying driver so every emission path is exercised.
+// kind, a time-varying driver and a branch invariant so every emission path is exercised.
 mechanism! {
     /// A slider-crank whose connecting rod is a distance link, driven by an oscillating crank.
     mechanism Linkage {
@@ -20,6 +20,7 @@ mechanism! {
         joint guide: prismatic(frame, slider, along (1, 0));
         joint rod: distance(crank @ (1, 0), slider, 2.5);
         driver swing: angle(crank) = amplitude * sin(3 * t) + t^2 / 10;
+        branch slider_ahead: dot(frame -> frame @ (1, 0), crank @ (1, 0) -> slider) > 0;
     }
 }
 
@@ -50,7 +51,7 @@ pub extern "C" fn mechgen_nostd_check(t_end: f64, steps: u32) -> usize {
         Ok(()) if ok => sink.0,
         Ok(()) => 0,
         Err(error) => {
-            let _ = write!(sink, "{}", error.describe(simulation.solver().mechanism()));
+            let _ = write!(sink, "{}", simulation.solver().describe(&error));
             0
         }
     }
