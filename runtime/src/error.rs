@@ -34,25 +34,31 @@ pub enum Quantity {
 }
 
 impl Quantity {
+    /// Writes the quantity, with `name` for a parameter or branch (its index otherwise).
     fn write(self, f: &mut fmt::Formatter<'_>, name: Option<&str>) -> fmt::Result {
-        match (self, name) {
-            (Self::Parameter(_), Some(name)) => write!(f, "parameter `{name}`"),
-            (Self::Parameter(index), None) => write!(f, "parameter #{index}"),
-            (Self::Branch(_), Some(name)) => write!(f, "branch invariant `{name}`"),
-            (Self::Branch(index), None) => write!(f, "branch invariant #{index}"),
-            _ => f.write_str(match self {
-                Self::Time => "the time",
-                Self::Guess => "the positions q (initial guess)",
-                Self::Phi => "the constraints Φ",
-                Self::Jacobian => "the Jacobian Φ_q",
-                Self::Nu => "the velocity right-hand side ν",
-                Self::Gamma => "the acceleration right-hand side γ",
-                Self::Step => "the Newton step Δq",
-                Self::Velocity => "the velocities q̇",
-                Self::Acceleration => "the accelerations q̈",
-                Self::Parameter(_) | Self::Branch(_) => "",
-            }),
-        }
+        let text = match self {
+            Self::Parameter(index) | Self::Branch(index) => {
+                let what = if matches!(self, Self::Parameter(_)) {
+                    "parameter"
+                } else {
+                    "branch invariant"
+                };
+                return match name {
+                    Some(name) => write!(f, "{what} `{name}`"),
+                    None => write!(f, "{what} #{index}"),
+                };
+            }
+            Self::Time => "the time",
+            Self::Guess => "the positions q (initial guess)",
+            Self::Phi => "the constraints Φ",
+            Self::Jacobian => "the Jacobian Φ_q",
+            Self::Nu => "the velocity right-hand side ν",
+            Self::Gamma => "the acceleration right-hand side γ",
+            Self::Step => "the Newton step Δq",
+            Self::Velocity => "the velocities q̇",
+            Self::Acceleration => "the accelerations q̈",
+        };
+        f.write_str(text)
     }
 }
 

@@ -118,15 +118,10 @@ impl Mechanism for Pendulum {
 
     fn derivatives(
         &self,
-
         q: &Vector<Self::Dim>,
-
         t: f64,
-
         factors: &Lu<Self::Dim>,
-
         qd: &mut Vector<Self::Dim>,
-
         qdd: &mut Vector<Self::Dim>,
     ) -> Result<(), SolveError> {
         solve_velocities(self, q, t, factors, qd)?;
@@ -227,15 +222,10 @@ mod dynamic {
 
         fn derivatives(
             &self,
-
             q: &Vector<Self::Dim>,
-
             t: f64,
-
             factors: &Lu<Self::Dim>,
-
             qd: &mut Vector<Self::Dim>,
-
             qdd: &mut Vector<Self::Dim>,
         ) -> Result<(), SolveError> {
             solve_velocities(self, q, t, factors, qd)?;

@@ -11,7 +11,9 @@ use nalgebra::DefaultAllocator;
 use crate::error::{Quantity, SolveError};
 use crate::lu::LuError;
 use crate::mechanism::{Matrix, Mechanism, Outputs, Storage, Vector};
-use crate::solver::{Convergence, Solver, check_finite, lu_error, max_abs, non_finite};
+use crate::solver::{
+    Convergence, Solver, check_finite, lu_error, max_abs, non_finite, scaled_max_abs,
+};
 
 /// Armijo constant: a step of length α must reduce the merit ‖D_r Φ‖₂ by at least this · α.
 const SUFFICIENT_DECREASE: f64 = 1e-4;
@@ -459,17 +461,10 @@ where
     (libm::sqrt(sum), max)
 }
 
-/// ‖D_c⁻¹ v‖∞: a step in scene lengths and radians.
+/// ‖D_c⁻¹ v‖∞: a step or a position in scene lengths and radians.
 fn scaled_max<D: nalgebra::Dim>(v: &Vector<D>, cols: &Vector<D>) -> f64
 where
     DefaultAllocator: Storage<D>,
 {
-    v.as_slice()
-        .iter()
-        .zip(cols.as_slice())
-        .fold(0.0, |m, (x, c)| {
-            let y = (x / c).abs();
-            // NaN propagates so that the caller reports a non-finite step.
-            if y > m || y.is_nan() { y } else { m }
-        })
+    scaled_max_abs(v.as_slice().iter().copied(), cols)
 }

@@ -174,20 +174,17 @@ where
     /// Displays `error` with the scene's names and, for the [`SolveError::Singular`] this
     /// solver just returned, every dependent equation and undetermined coordinate.
     pub fn describe<'a>(&'a self, error: &'a SolveError) -> Described<'a, M> {
-        let singular = matches!(error, SolveError::Singular { .. });
+        let (dependent, undetermined) = match error {
+            SolveError::Singular { .. } => {
+                (self.dependent_equations(), self.undetermined_coordinates())
+            }
+            _ => (&[][..], &[][..]),
+        };
         Described {
             error,
             mechanism: &self.mechanism,
-            dependent: if singular {
-                self.dependent_equations()
-            } else {
-                &[]
-            },
-            undetermined: if singular {
-                self.undetermined_coordinates()
-            } else {
-                &[]
-            },
+            dependent,
+            undetermined,
         }
     }
 
@@ -249,11 +246,8 @@ where
     /// ‖D_c⁻¹ (a − b)‖∞: how far apart two configurations are, in scene lengths and radians
     /// (with the scales of the last solve).
     pub fn scaled_distance(&self, a: &Vector<M::Dim>, b: &Vector<M::Dim>) -> f64 {
-        let (a, b, cols) = (a.as_slice(), b.as_slice(), self.cols.as_slice());
-        a.iter()
-            .zip(b)
-            .zip(cols)
-            .fold(0.0, |m, ((x, y), c)| m.max(((x - y) / c).abs()))
+        let difference = a.as_slice().iter().zip(b.as_slice()).map(|(x, y)| x - y);
+        scaled_max_abs(difference, &self.cols)
     }
 
     /// Every parameter finite: a NaN set through a public field is reported as itself, not as
@@ -413,6 +407,18 @@ where
     check_finite(qdd, t, Quantity::Gamma)?;
     factors.solve_in_place(qdd).map_err(|e| lu_error(e, t))?;
     check_finite(qdd, t, Quantity::Acceleration)
+}
+
+/// ‖D_c⁻¹ v‖∞ for the entries of `v` (scene lengths and radians); a NaN entry makes it NaN, so
+/// that callers see a non-finite step rather than a small one.
+pub(crate) fn scaled_max_abs<D: Dim>(v: impl Iterator<Item = f64>, cols: &Vector<D>) -> f64
+where
+    DefaultAllocator: Storage<D>,
+{
+    v.zip(cols.as_slice()).fold(0.0, |m, (x, c)| {
+        let y = (x / c).abs();
+        if y > m || y.is_nan() { y } else { m }
+    })
 }
 
 /// ‖v‖∞ over the contiguous storage (nalgebra's `amax` iterates element by element, slowly).

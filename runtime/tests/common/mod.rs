@@ -206,15 +206,10 @@ impl Mechanism for SliderCrank {
 
     fn derivatives(
         &self,
-
         q: &Vector<Self::Dim>,
-
         t: f64,
-
         factors: &Lu<Self::Dim>,
-
         qd: &mut Vector<Self::Dim>,
-
         qdd: &mut Vector<Self::Dim>,
     ) -> Result<(), SolveError> {
         solve_velocities(self, q, t, factors, qd)?;
