@@ -1,18 +1,23 @@
-//! A compiled scene evaluated by the interpreter, behind the runtime's `Mechanism` trait.
+//! A compiled scene evaluated by the interpreter, behind the runtime's `Mechanism` and
+//! `Structured` traits.
 //!
-//! This is what a run-time (non-generated) library would do: the same IR as the generated code,
-//! walked at run time. It lets the CLI, the tests and the report drive the one solver
-//! implementation of `mechgen-runtime` with scenes read from `.mech` files.
+//! This is what a run-time (non-generated) library would do: the same IR and the same solve
+//! plan as the generated code, walked at run time (tapes for the expressions, the static LU's
+//! operation list for the factorisations). It lets the CLI, the tests and the report drive the
+//! one solver implementation of `mechgen-runtime` with scenes read from `.mech` files, and it
+//! agrees with generated code to the bit.
 
 use std::cell::RefCell;
 
 use mechgen::Scene;
+use mechgen::factor::Factorization;
 use mechgen::interpret::{Inputs, Tape};
 use mechgen::kinematics::LengthScale;
+use mechgen::structure::{self, Phase, Plan};
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{
-    Accelerations, Lu, Matrix, Mechanism, Outputs, ParameterError, SolveError, Unit, Vector,
-    Velocities, solve_accelerations, solve_velocities,
+    Accelerations, Block, Matrix, Mechanism, Outputs, ParameterError, Pattern, Stage, Structured,
+    Unit, VecBuffers, Vector, Velocities,
 };
 
 /// A scene whose kinematics are interpreted rather than generated.
@@ -39,10 +44,135 @@ pub struct Interpreted {
     length_scale: LengthScale,
     lengths: Tape,
     branch_names: Vec<String>,
-    /// One tape per branch invariant (its signed value).
+    /// One tape per branch invariant (its signed value), and the same reading the trig cache.
     branches: Vec<Tape>,
+    cached_branches: Vec<Tape>,
+    /// The solve plan, stage by stage, and the earlier stages each reads.
+    stages: Vec<PlanStage>,
+    reads: Vec<Vec<usize>>,
+    /// Workspace sizes: largest block, most value slots, trig cache.
+    largest: (usize, usize, usize),
     /// Tape slots and output values, reused by every call (evaluation is `&self`).
     scratch: RefCell<Scratch>,
+}
+
+/// One stage of the plan, with its tapes.
+#[derive(Debug, Clone)]
+enum PlanStage {
+    Explicit {
+        equations: Vec<usize>,
+        coordinates: Vec<usize>,
+        /// Positions, velocities, accelerations (the latter two if computed).
+        levels: [Option<Tape>; 3],
+        /// The sines and cosines the stage caches, and where.
+        trig: Option<(Tape, Vec<usize>)>,
+    },
+    Block {
+        equations: Vec<usize>,
+        coordinates: Vec<usize>,
+        pattern: Vec<(usize, usize)>,
+        slots: usize,
+        /// Residuals, then Jacobian values.
+        jacobian: Tape,
+        factorization: Option<Factorization>,
+        velocity_rhs: Option<Tape>,
+        acceleration_rhs: Option<Tape>,
+        trig: Option<(Tape, Vec<usize>)>,
+    },
+}
+
+impl PlanStage {
+    /// Stage `s` of `plan`, its tapes reading the trig cache as the generated kernels do.
+    fn new(arena: &mechgen::expr::Arena, plan: &Plan, s: usize) -> Self {
+        let tape = |roots: &[mechgen::expr::Id], phase: Phase| {
+            Tape::with_inputs(arena, roots, &plan.trig.reads(arena, roots, s, phase))
+        };
+        let fills: Vec<usize> = plan.trig.fills(s).collect();
+        let trig = (!fills.is_empty()).then(|| {
+            let roots: Vec<_> = fills
+                .iter()
+                .flat_map(|&m| {
+                    let (sin, cos) = plan.trig.nodes[m];
+                    [sin, cos]
+                })
+                .collect();
+            let slots = fills.iter().flat_map(|&m| [2 * m, 2 * m + 1]).collect();
+            (tape(&roots, Phase::Positions), slots)
+        });
+        match &plan.stages[s] {
+            structure::Stage::Explicit(assignments) => {
+                let level = |level: fn(&structure::Assignment) -> Option<mechgen::expr::Id>,
+                             phase| {
+                    let ids: Option<Vec<_>> = assignments.iter().map(level).collect();
+                    ids.map(|ids| tape(&ids, phase))
+                };
+                PlanStage::Explicit {
+                    equations: assignments.iter().map(|a| a.equation).collect(),
+                    coordinates: assignments.iter().map(|a| a.coordinate).collect(),
+                    levels: [
+                        level(|a| Some(a.position), Phase::Positions),
+                        level(|a| a.velocity, Phase::After),
+                        level(|a| a.acceleration, Phase::After),
+                    ],
+                    trig,
+                }
+            }
+            structure::Stage::Block(block) => {
+                let roots: Vec<_> = block
+                    .residuals
+                    .iter()
+                    .copied()
+                    .chain(block.entries.iter().map(|e| e.2))
+                    .collect();
+                PlanStage::Block {
+                    equations: block.equations.clone(),
+                    coordinates: block.coordinates.clone(),
+                    pattern: block.entries.iter().map(|&(r, c, _)| (r, c)).collect(),
+                    slots: block.slots(),
+                    jacobian: tape(&roots, Phase::Positions),
+                    factorization: block.factorization.clone(),
+                    velocity_rhs: block.velocity_rhs.as_deref().map(|v| tape(v, Phase::After)),
+                    acceleration_rhs: block
+                        .acceleration_rhs
+                        .as_deref()
+                        .map(|v| tape(v, Phase::After)),
+                    trig,
+                }
+            }
+        }
+    }
+
+    fn tapes(&self) -> impl Iterator<Item = &Tape> {
+        let (levels, block, trig): (&[Option<Tape>], [Option<&Tape>; 3], _) = match self {
+            PlanStage::Explicit { levels, trig, .. } => (&levels[..], [None; 3], trig),
+            PlanStage::Block {
+                jacobian,
+                velocity_rhs,
+                acceleration_rhs,
+                trig,
+                ..
+            } => (
+                &[][..],
+                [
+                    Some(jacobian),
+                    velocity_rhs.as_ref(),
+                    acceleration_rhs.as_ref(),
+                ],
+                trig,
+            ),
+        };
+        levels
+            .iter()
+            .flatten()
+            .chain(block.into_iter().flatten())
+            .chain(trig.iter().map(|(tape, _)| tape))
+    }
+
+    fn trig(&self) -> Option<&(Tape, Vec<usize>)> {
+        match self {
+            PlanStage::Explicit { trig, .. } | PlanStage::Block { trig, .. } => trig.as_ref(),
+        }
+    }
 }
 
 #[derive(Debug, Clone, Default)]
@@ -77,12 +207,28 @@ impl Interpreted {
             .iter()
             .map(|&b| Tape::new(arena, &[b]))
             .collect();
+        let plan: &Plan = &scene.plan;
+        let stages: Vec<PlanStage> = (0..plan.stages.len())
+            .map(|s| PlanStage::new(arena, plan, s))
+            .collect();
+        let cached_branches: Vec<Tape> = kin
+            .branches
+            .iter()
+            .map(|&b| {
+                let cached = plan
+                    .trig
+                    .reads(arena, &[b], plan.stages.len(), Phase::Positions);
+                Tape::with_inputs(arena, &[b], &cached)
+            })
+            .collect();
         let slots = tapes
             .iter()
             .chain(&nu)
             .chain(&gamma)
             .chain([&lengths])
             .chain(&branches)
+            .chain(&cached_branches)
+            .chain(stages.iter().flat_map(PlanStage::tapes))
             .map(Tape::len)
             .max()
             .unwrap_or(0);
@@ -90,6 +236,7 @@ impl Interpreted {
             .len()
             .max(model.dim())
             .max(kin.length_scale.dependent.len())
+            .max(plan.largest_block() + plan.largest_slots())
             .max(1);
         let [guess, phi, jacobian, phi_and_jacobian] = tapes;
         let outputs = match model.outputs {
@@ -117,6 +264,10 @@ impl Interpreted {
             lengths,
             branch_names: model.branches.iter().map(|b| b.name.clone()).collect(),
             branches,
+            cached_branches,
+            stages,
+            reads: plan.reads.clone(),
+            largest: (plan.largest_block(), plan.largest_slots(), plan.trig.len()),
             scratch: RefCell::new(Scratch {
                 slots: vec![0.0; slots],
                 values: vec![0.0; values],
@@ -152,9 +303,22 @@ impl Interpreted {
     }
 
     fn inputs<'a>(&'a self, q: &'a [f64], qd: &'a [f64], t: f64) -> Inputs<'a> {
+        self.inputs_with(q, qd, &[], &[], t)
+    }
+
+    fn inputs_with<'a>(
+        &'a self,
+        q: &'a [f64],
+        qd: &'a [f64],
+        qdd: &'a [f64],
+        trig: &'a [f64],
+        t: f64,
+    ) -> Inputs<'a> {
         Inputs {
             q,
             qd,
+            qdd,
+            trig,
             t,
             params: &self.params,
         }
@@ -304,45 +468,252 @@ impl Mechanism for Interpreted {
         self.outputs
     }
 
-    fn derivatives(
-        &self,
-        q: &Vector<Dyn>,
-        t: f64,
-        factors: &Lu<Dyn>,
-        qd: &mut Vector<Dyn>,
-        qdd: &mut Vector<Dyn>,
-    ) -> Result<(), SolveError> {
-        if self.outputs >= Outputs::Velocities {
-            solve_velocities(self, q, t, factors, qd)?;
-        }
-        if self.outputs >= Outputs::Accelerations {
-            solve_accelerations(self, q, qd, t, factors, qdd)?;
-        }
-        Ok(())
-    }
-}
-
-/// One interpreter type serves every scene, so it implements the derivative traits for all;
-/// a scene that did not ask for an output writes NaN there, and [`Mechanism::derivatives`]
-/// never asks for it.
-impl Velocities for Interpreted {
     fn nu(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
         match &self.nu {
             Some(tape) => self.run(tape, self.inputs(q.as_slice(), &[], t), |v| {
-                copy_into(v, out)
+                copy_into(v, out);
             }),
             None => out.as_mut_slice().fill(f64::NAN),
         }
     }
-}
 
-impl Accelerations for Interpreted {
     fn gamma(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
         match &self.gamma {
             Some(tape) => self.run(tape, self.inputs(q.as_slice(), qd.as_slice(), t), |v| {
                 copy_into(v, out);
             }),
             None => out.as_mut_slice().fill(f64::NAN),
+        }
+    }
+}
+
+/// One interpreter type serves every scene, so it is marked as computing every level; a scene
+/// that did not ask for an output writes NaN there, and the solver never asks for it.
+impl Velocities for Interpreted {}
+impl Accelerations for Interpreted {}
+
+impl Structured for Interpreted {
+    type Workspace = VecBuffers;
+
+    fn workspace(&self) -> VecBuffers {
+        VecBuffers::new(
+            self.largest.0,
+            self.largest.1,
+            self.stages.len().max(1),
+            self.coordinates.len(),
+            self.largest.2,
+        )
+    }
+
+    fn stage_count(&self) -> usize {
+        self.stages.len()
+    }
+
+    fn stage(&self, index: usize) -> Option<Stage<'_>> {
+        let reads = self.reads.get(index)?;
+        Some(match self.stages.get(index)? {
+            PlanStage::Explicit {
+                equations,
+                coordinates,
+                ..
+            } => Stage::Explicit {
+                equations,
+                coordinates,
+                reads,
+            },
+            PlanStage::Block {
+                equations,
+                coordinates,
+                pattern,
+                slots,
+                factorization,
+                ..
+            } => Stage::Block(Block {
+                equations,
+                coordinates,
+                pattern: Pattern::Sparse(pattern),
+                slots: *slots,
+                static_pivots: factorization.is_some(),
+                reads,
+            }),
+        })
+    }
+
+    fn assign_positions(&self, stage: usize, q: &mut Vector<Dyn>, trig: &[f64], t: f64) {
+        let inputs = self.inputs_with(q.as_slice(), &[], &[], trig, t);
+        if self.evaluate_level(stage, 0, inputs) {
+            self.write_level(stage, q);
+        }
+    }
+
+    fn assign_velocities(
+        &self,
+        stage: usize,
+        q: &Vector<Dyn>,
+        trig: &[f64],
+        qd: &mut Vector<Dyn>,
+        t: f64,
+    ) {
+        let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), &[], trig, t);
+        if self.evaluate_level(stage, 1, inputs) {
+            self.write_level(stage, qd);
+        }
+    }
+
+    fn assign_accelerations(
+        &self,
+        stage: usize,
+        q: &Vector<Dyn>,
+        trig: &[f64],
+        qd: &Vector<Dyn>,
+        qdd: &mut Vector<Dyn>,
+        t: f64,
+    ) {
+        let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t);
+        if self.evaluate_level(stage, 2, inputs) {
+            self.write_level(stage, qdd);
+        }
+    }
+
+    fn block_jacobian(
+        &self,
+        stage: usize,
+        q: &Vector<Dyn>,
+        trig: &[f64],
+        t: f64,
+        phi: &mut [f64],
+        values: &mut [f64],
+    ) {
+        if let Some(PlanStage::Block {
+            jacobian, pattern, ..
+        }) = self.stages.get(stage)
+        {
+            let inputs = self.inputs_with(q.as_slice(), &[], &[], trig, t);
+            self.run(jacobian, inputs, |v| {
+                let (residuals, entries) = v.split_at(phi.len());
+                phi.copy_from_slice(residuals);
+                values[..pattern.len()].copy_from_slice(&entries[..pattern.len()]);
+            });
+        }
+    }
+
+    fn fill_trig(&self, stage: usize, q: &Vector<Dyn>, trig: &mut [f64]) {
+        if let Some((tape, slots)) = self.stages.get(stage).and_then(PlanStage::trig) {
+            self.run(tape, self.inputs(q.as_slice(), &[], 0.0), |v| {
+                for (&slot, &value) in slots.iter().zip(v) {
+                    trig[slot] = value;
+                }
+            });
+        }
+    }
+
+    fn branch(&self, index: usize, q: &Vector<Dyn>, trig: &[f64]) -> f64 {
+        let Some(tape) = self.cached_branches.get(index) else {
+            return f64::NAN;
+        };
+        let mut value = f64::NAN;
+        let inputs = self.inputs_with(q.as_slice(), &[], &[], trig, 0.0);
+        self.run(tape, inputs, |v| {
+            value = v.first().copied().unwrap_or(f64::NAN)
+        });
+        value
+    }
+
+    fn factor(&self, stage: usize, values: &mut [f64], tiny: f64, limit: f64) -> Result<(), usize> {
+        match self.factorization(stage) {
+            Some(f) if values.len() >= f.slots => f.factor(values, tiny, limit),
+            _ => Err(0),
+        }
+    }
+
+    fn solve(&self, stage: usize, values: &[f64], x: &mut [f64]) {
+        if let Some(f) = self.factorization(stage) {
+            f.solve(values, x);
+        }
+    }
+
+    fn solve_transpose(&self, stage: usize, values: &[f64], x: &mut [f64]) {
+        if let Some(f) = self.factorization(stage) {
+            f.solve_transpose(values, x);
+        }
+    }
+
+    fn velocity_rhs(
+        &self,
+        stage: usize,
+        q: &Vector<Dyn>,
+        trig: &[f64],
+        qd: &Vector<Dyn>,
+        t: f64,
+        out: &mut [f64],
+    ) {
+        match self.stages.get(stage) {
+            Some(PlanStage::Block {
+                velocity_rhs: Some(tape),
+                ..
+            }) => {
+                let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), &[], trig, t);
+                self.run(tape, inputs, |v| out.copy_from_slice(&v[..out.len()]));
+            }
+            _ => out.fill(f64::NAN),
+        }
+    }
+
+    fn acceleration_rhs(
+        &self,
+        stage: usize,
+        q: &Vector<Dyn>,
+        trig: &[f64],
+        qd: &Vector<Dyn>,
+        qdd: &Vector<Dyn>,
+        t: f64,
+        out: &mut [f64],
+    ) {
+        match self.stages.get(stage) {
+            Some(PlanStage::Block {
+                acceleration_rhs: Some(tape),
+                ..
+            }) => {
+                let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t);
+                self.run(tape, inputs, |v| out.copy_from_slice(&v[..out.len()]));
+            }
+            _ => out.fill(f64::NAN),
+        }
+    }
+}
+
+impl Interpreted {
+    fn factorization(&self, stage: usize) -> Option<&Factorization> {
+        match self.stages.get(stage)? {
+            PlanStage::Block { factorization, .. } => factorization.as_ref(),
+            PlanStage::Explicit { .. } => None,
+        }
+    }
+
+    /// Evaluates level `level` (positions, velocities, accelerations) of an explicit stage into
+    /// the scratch values; false if the stage has no such level. Every value is computed
+    /// before [`Interpreted::write_level`] writes any back, as generated code loads its inputs
+    /// first.
+    fn evaluate_level(&self, stage: usize, level: usize, inputs: Inputs<'_>) -> bool {
+        let Some(PlanStage::Explicit { levels, .. }) = self.stages.get(stage) else {
+            return false;
+        };
+        let Some(tape) = &levels[level] else {
+            return false;
+        };
+        let mut scratch = self.scratch.borrow_mut();
+        let Scratch { slots, values } = &mut *scratch;
+        tape.eval(inputs, slots, values);
+        true
+    }
+
+    /// Writes the values of [`Interpreted::evaluate_level`] to the stage's coordinates of `out`.
+    fn write_level(&self, stage: usize, out: &mut Vector<Dyn>) {
+        if let Some(PlanStage::Explicit { coordinates, .. }) = self.stages.get(stage) {
+            let scratch = self.scratch.borrow();
+            for (&c, &v) in coordinates.iter().zip(&scratch.values) {
+                out[c] = v;
+            }
         }
     }
 }

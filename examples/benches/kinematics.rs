@@ -19,7 +19,9 @@ use mechgen_cli::Interpreted;
 use mechgen_examples::report::{AutoDiff, CentralDifference, ForwardDifference, Plan};
 use mechgen_examples::scenes::{FourBar, PistonCrank};
 use mechgen_runtime::nalgebra::DefaultAllocator;
-use mechgen_runtime::{Matrix, Mechanism, Simulation, Solver, SolverOptions, Storage, Vector};
+use mechgen_runtime::{
+    Dense, Matrix, Simulation, Solver, SolverOptions, Storage, Structured, Vector,
+};
 
 /// The seed generated naively (no folding, no simplification, no shared sub-expressions) by
 /// the package's `build.rs`: the baseline the lean code is timed against. Bench-only, so the
@@ -44,7 +46,7 @@ fn interpreted(file: &str) -> Interpreted {
 /// Benchmarks one mechanism under `label`: Φ, Φ_q, Φ+Φ_q at an assembled state, then a step.
 fn bench_scene<M>(c: &mut Criterion, label: &str, mechanism: M, period: f64)
 where
-    M: Mechanism + Clone,
+    M: Structured + Clone,
     DefaultAllocator: Storage<M::Dim>,
 {
     let reference = Plan::full().reference;
@@ -129,20 +131,26 @@ fn kinematics(c: &mut Criterion) {
     bench_scene(
         c,
         "seed/forward_difference",
-        ForwardDifference::new(seed),
+        Dense::new(ForwardDifference::new(seed)),
         seed_period,
     );
     bench_scene(
         c,
         "seed/central_difference",
-        CentralDifference::new(seed),
+        Dense::new(CentralDifference::new(seed)),
         seed_period,
     );
     let seed_ad = AutoDiff::new(seed, &scene("piston_crank.mech")).expect("twin scenes match");
-    bench_scene(c, "seed/autodiff", seed_ad, seed_period);
+    bench_scene(c, "seed/autodiff", Dense::new(seed_ad), seed_period);
     // The same seed emitted naively (no folding, no simplification, no sharing): what the lean
     // emission saves, measured in the same run.
     bench_scene(c, "seed/naive", naive::PistonCrank::default(), seed_period);
+    bench_scene(
+        c,
+        "seed/dense",
+        Dense::new(PistonCrank::default()),
+        seed_period,
+    );
     bench_scene(
         c,
         "seed/interpreted",
@@ -155,17 +163,22 @@ fn kinematics(c: &mut Criterion) {
     bench_scene(
         c,
         "four_bar/forward_difference",
-        ForwardDifference::new(four_bar),
+        Dense::new(ForwardDifference::new(four_bar)),
         four_bar_period,
     );
     bench_scene(
         c,
         "four_bar/central_difference",
-        CentralDifference::new(four_bar),
+        Dense::new(CentralDifference::new(four_bar)),
         four_bar_period,
     );
     let four_bar_ad = AutoDiff::new(four_bar, &scene("four_bar.mech")).expect("twin scenes match");
-    bench_scene(c, "four_bar/autodiff", four_bar_ad, four_bar_period);
+    bench_scene(
+        c,
+        "four_bar/autodiff",
+        Dense::new(four_bar_ad),
+        four_bar_period,
+    );
     bench_scene(
         c,
         "four_bar/interpreted",

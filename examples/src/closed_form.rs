@@ -235,6 +235,57 @@ impl SliderCrank {
     }
 }
 
+/// The offset slider-crank of `scenes::OffsetSlider`, posed by its crank angle (positions only).
+///
+/// Bodies, in coordinate order: frame (ground at the origin), crank (reference point at the
+/// pivot), rod (reference point at the crank pin, slider pin at rod@`(rod, 0)`), slider (on the
+/// line `y = offset`, not rotating). Branch: the slider ahead of the crank pin.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OffsetSlider {
+    /// Crank radius (mm). Scene: 30.
+    pub crank: f64,
+    /// Rod length (mm). Scene: 80.
+    pub rod: f64,
+    /// Height of the slider's line above the crank pivot (mm). Scene: 12.
+    pub offset: f64,
+}
+
+impl Default for OffsetSlider {
+    fn default() -> Self {
+        Self {
+            crank: 30.0,
+            rod: 80.0,
+            offset: 12.0,
+        }
+    }
+}
+
+impl OffsetSlider {
+    /// Positions with the crank at angle `theta`.
+    pub fn q(&self, theta: f64) -> [f64; 12] {
+        let (sin, cos) = theta.sin_cos();
+        let (px, py) = (self.crank * cos, self.crank * sin);
+        // The rod spans the height from the pin to the slider's line.
+        let rise = self.offset - py;
+        let reach = ((self.rod - rise) * (self.rod + rise)).sqrt();
+        let phi = rise.atan2(reach);
+        [
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            theta,
+            px,
+            py,
+            phi,
+            px + reach,
+            self.offset,
+            0.0,
+        ]
+    }
+}
+
 /// Coordinate names of the crank-rocker four-bar, in vector order (bodies frame, crank, coupler, rocker).
 pub const FOUR_BAR_COORDS: &[&str] = &[
     "frame.x",

@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{
-    Accelerations, Mechanism, Simulation, SolveError, Solver, State, write_csv_header,
+    Accelerations, Mechanism, Simulation, SolveError, Solver, State, Structured, write_csv_header,
 };
 
 use crate::accuracy::{ErrorTracker, RelativeErrors};
@@ -85,7 +85,7 @@ pub fn revolution<M, const N: usize>(
     exact: impl Fn(f64) -> Kinematics<N>,
 ) -> Result<Revolution<M, N>, SolveError>
 where
-    M: Accelerations<Dim = Const<N>> + Clone,
+    M: Structured<Dim = Const<N>> + Accelerations + Clone,
 {
     let mut states = Vec::with_capacity(steps + 1);
     let mut simulation = Simulation::new(Solver::new(mechanism.clone()), 0.0)?;

@@ -6,8 +6,8 @@
 use std::time::Instant;
 
 use mechgen_runtime::{
-    Accelerations, Mechanism, Simulation, SolveError, Solver, SolverOptions, State, mechanism,
-    nalgebra::Const,
+    Accelerations, Mechanism, Simulation, SolveError, Solver, SolverOptions, State, Structured,
+    mechanism, nalgebra::Const,
 };
 
 use num_dual::DualNum;
@@ -149,7 +149,7 @@ pub fn run<M, const N: usize>(
     exact: impl Fn(f64) -> Kinematics<N>,
 ) -> Measured
 where
-    M: Accelerations<Dim = Const<N>>,
+    M: Structured<Dim = Const<N>> + Accelerations,
 {
     let mut states: Vec<State<M>> = Vec::with_capacity(steps + 1);
     let started = Instant::now();

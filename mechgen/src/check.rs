@@ -11,6 +11,7 @@ use syn::Ident;
 
 use crate::error::Errors;
 use crate::expr::{Arena, Func, Id, Node, Var};
+use crate::graph::{self, UNMATCHED};
 use crate::model::{
     Body, Branch, Constraint, ConstraintKind, Driven, Model, Outputs, Param, Point,
 };
@@ -728,8 +729,6 @@ pub struct Structure {
     pub under_free: Vec<usize>,
 }
 
-const UNMATCHED: usize = usize::MAX;
-
 impl Structure {
     /// The structure of a model's Φ: the equations are built into the model's arena (the same
     /// hash-consed nodes `kinematics` derives from later) and each one's coordinates read off.
@@ -759,61 +758,10 @@ impl Structure {
     /// for a free coordinate and visit stamps: O(equations × non-zeros) at worst, near linear on
     /// the chains and trees of real mechanisms.
     pub fn of_pattern(rows: &[Vec<usize>], columns: usize) -> Self {
-        let mut row_match = vec![UNMATCHED; rows.len()];
-        let mut col_match = vec![UNMATCHED; columns];
-        for (r, cols) in rows.iter().enumerate() {
-            if let Some(&c) = cols.iter().find(|&&c| col_match[c] == UNMATCHED) {
-                row_match[r] = c;
-                col_match[c] = r;
-            }
-        }
-        let mut stamp = vec![0usize; columns];
-        let mut stack: Vec<(usize, usize)> = Vec::new();
-        for root in 0..rows.len() {
-            if row_match[root] != UNMATCHED {
-                continue;
-            }
-            let round = root + 1;
-            stack.clear();
-            stack.push((root, 0));
-            let mut found = None;
-            while let Some((row, next)) = stack.last_mut() {
-                let row = *row;
-                // Look-ahead: a free coordinate of this row ends the path at once.
-                if *next == 0
-                    && let Some(&c) = rows[row].iter().find(|&&c| col_match[c] == UNMATCHED)
-                {
-                    found = Some(c);
-                    break;
-                }
-                match rows[row].get(*next) {
-                    Some(&c) => {
-                        *next += 1;
-                        if stamp[c] != round {
-                            stamp[c] = round;
-                            stack.push((col_match[c], 0));
-                        }
-                    }
-                    None => {
-                        stack.pop();
-                    }
-                }
-            }
-            // Flip the path: the top row takes the free coordinate, every row below it the
-            // coordinate through which the walk left it.
-            if let Some(mut c) = found {
-                while let Some((row, _)) = stack.pop() {
-                    row_match[row] = c;
-                    col_match[c] = row;
-                    if let Some(&(below, next)) = stack.last() {
-                        c = rows[below][next - 1];
-                    }
-                }
-            }
-        }
-
+        let matching = graph::maximum_matching(rows, columns);
+        let (row_match, col_match) = (&matching.row, &matching.column);
         let mut structure = Structure {
-            rank: row_match.iter().filter(|&&c| c != UNMATCHED).count(),
+            rank: matching.size(),
             ..Structure::default()
         };
         // Over-determined: alternating walks from unmatched equations.

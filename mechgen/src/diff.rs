@@ -118,6 +118,7 @@ mod tests {
             match var {
                 Var::Q(k) => env.q[k as usize] += delta,
                 Var::Qd(k) => env.qd[k as usize] += delta,
+                Var::Qdd(k) => env.qdd[k as usize] += delta,
                 Var::T => env.t += delta,
             }
             eval(arena, e, &env)
@@ -145,6 +146,7 @@ mod tests {
         let env = Env {
             q: vec![0.7, 1.3],
             qd: vec![0.0, 0.0],
+            qdd: vec![],
             t: 0.4,
             params: vec![],
         };

@@ -1,4 +1,4 @@
-//! The expression IR: a hash-consed DAG of scalar expressions over q, q̇, t and parameters.
+//! The expression IR: a hash-consed DAG of scalar expressions over q, q̇, q̈, t and parameters.
 //!
 //! Every node lives once in an [`Arena`]; structurally equal expressions get the same [`Id`], so
 //! common sub-expressions (each sin θ, cos θ, products of them) are shared by construction and the
@@ -6,7 +6,7 @@
 //! `x·0`, `x·1`, `x+0`, `−(−x)`, functions of constants), so no separate simplification pass can be
 //! forgotten and no identically-zero expression survives as anything but [`Arena::zero`].
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Handle of a node in an [`Arena`]. Ids are dense and ordered by creation.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -26,6 +26,9 @@ pub enum Var {
     Q(u32),
     /// Coordinate velocity q̇_k (an independent symbol when forming γ).
     Qd(u32),
+    /// Coordinate acceleration q̈_k (read by the structured solve's acceleration right-hand
+    /// sides, where earlier stages' accelerations are known).
+    Qdd(u32),
     /// Time.
     T,
 }
@@ -183,6 +186,11 @@ impl Arena {
         self.nodes.push(node);
         self.lookup.insert(node, id);
         id
+    }
+
+    /// The id of `node`, if the arena holds it (nothing is created).
+    pub fn find(&self, node: Node) -> Option<Id> {
+        self.lookup.get(&node).copied()
     }
 
     /// The constant 0.
@@ -418,6 +426,44 @@ impl Arena {
         a.into_iter().chain(b)
     }
 
+    /// `e` with every variable of `map` replaced by its expression, rebuilt through the
+    /// simplifying constructors (so substituting constants folds); `memo` remembers rebuilt
+    /// nodes for this `map` across calls. Iterative: deep expressions cannot overflow the stack.
+    pub fn substitute(&mut self, e: Id, map: &HashMap<Var, Id>, memo: &mut HashMap<Id, Id>) -> Id {
+        let mut stack = vec![(e, false)];
+        while let Some((id, expanded)) = stack.pop() {
+            if memo.contains_key(&id) {
+                continue;
+            }
+            let node = self.node(id);
+            if !expanded {
+                stack.push((id, true));
+                stack.extend(self.children(id).map(|c| (c, false)));
+                continue;
+            }
+            let get = |x: Id| memo.get(&x).copied().unwrap_or(x);
+            let rebuilt = match node {
+                Node::Var(v) => map.get(&v).copied().unwrap_or(id),
+                Node::Const(_) | Node::Param(_) => id,
+                _ if self.children(id).all(|c| get(c) == c) => id,
+                Node::Neg(a) => self.neg(get(a)),
+                Node::Add(a, b) => self.add(get(a), get(b)),
+                Node::Sub(a, b) => self.sub(get(a), get(b)),
+                Node::Mul(a, b) => self.mul(get(a), get(b)),
+                Node::Div(a, b) => self.div(get(a), get(b)),
+                Node::Powi(a, n) => self.powi(get(a), n),
+                Node::Call(f, a) => self.call(f, get(a)),
+            };
+            memo.insert(id, rebuilt);
+        }
+        memo.get(&e).copied().unwrap_or(e)
+    }
+
+    /// True if the expression reads no variable (a constant or an expression in parameters).
+    pub fn is_invariant(&self, id: Id) -> bool {
+        !self.any_node(id, |node| matches!(node, Node::Var(_)))
+    }
+
     /// True if `var` occurs in the expression.
     pub fn depends_on(&self, id: Id, var: Var) -> bool {
         self.any_node(id, |node| node == Node::Var(var))
@@ -425,10 +471,12 @@ impl Arena {
 
     /// True if some node reachable from `id` satisfies `pred`.
     pub fn any_node(&self, id: Id, pred: impl Fn(Node) -> bool) -> bool {
-        let mut seen = vec![false; self.nodes.len()];
+        // A set rather than an arena-sized vector: the cost follows the expression, not the
+        // arena (large scenes ask this of thousands of small expressions).
+        let mut seen = HashSet::new();
         let mut stack = vec![id];
         while let Some(next) = stack.pop() {
-            if std::mem::replace(&mut seen[next.index()], true) {
+            if !seen.insert(next) {
                 continue;
             }
             if pred(self.node(next)) {
@@ -441,11 +489,11 @@ impl Arena {
 
     /// The variables occurring in an expression, sorted.
     pub fn variables(&self, id: Id) -> Vec<Var> {
-        let mut seen = vec![false; self.nodes.len()];
+        let mut seen = HashSet::new();
         let mut stack = vec![id];
         let mut vars = Vec::new();
         while let Some(next) = stack.pop() {
-            if std::mem::replace(&mut seen[next.index()], true) {
+            if !seen.insert(next) {
                 continue;
             }
             if let Node::Var(v) = self.node(next) {

@@ -10,6 +10,7 @@
 //! equations the generated code evaluates.
 
 use core::ops::{Add, Div, Mul, Neg, Sub};
+use std::collections::{HashMap, HashSet};
 
 use crate::expr::{Arena, Func, Id, Node, Var};
 
@@ -53,6 +54,8 @@ pub struct Env {
     pub q: Vec<f64>,
     /// Velocities q̇ (only read by γ).
     pub qd: Vec<f64>,
+    /// Accelerations q̈ (only read by the structured solve's acceleration right-hand sides).
+    pub qdd: Vec<f64>,
     /// Time.
     pub t: f64,
     /// Parameter values by declaration index.
@@ -69,6 +72,11 @@ pub struct Inputs<'a, S = f64> {
     pub q: &'a [S],
     /// Velocities q̇ (empty when the outputs do not need them).
     pub qd: &'a [S],
+    /// Accelerations q̈ (empty unless evaluating acceleration right-hand sides).
+    pub qdd: &'a [S],
+    /// The solve's trig cache (sines and cosines of solved angles), for tapes built with
+    /// [`Tape::with_inputs`]; empty otherwise.
+    pub trig: &'a [f64],
     /// Time.
     pub t: f64,
     /// Parameter values by declaration index.
@@ -81,6 +89,8 @@ impl Env {
         Inputs {
             q: &self.q,
             qd: &self.qd,
+            qdd: &self.qdd,
+            trig: &[],
             t: self.t,
             params: &self.params,
         }
@@ -103,6 +113,9 @@ enum Op {
     Param(usize),
     Q(usize),
     Qd(usize),
+    Qdd(usize),
+    /// A node read from the trig cache instead of computed.
+    Cached(usize),
     T,
     Neg(usize),
     Add(usize, usize),
@@ -123,16 +136,26 @@ pub struct Tape {
 impl Tape {
     /// Compiles the outputs `roots` (in order) of `arena`.
     pub fn new(arena: &Arena, roots: &[Id]) -> Self {
-        let order = topological_order(arena, roots);
-        let mut slot = vec![usize::MAX; arena.len()];
+        Self::with_inputs(arena, roots, &HashMap::new())
+    }
+
+    /// Compiles the outputs `roots`, reading the nodes of `cached` from [`Inputs::trig`] (at
+    /// the given positions) instead of computing them.
+    pub fn with_inputs(arena: &Arena, roots: &[Id], cached: &HashMap<Id, usize>) -> Self {
+        let order = topological_order_with(arena, roots, |id| cached.contains_key(&id));
+        // A map rather than an arena-sized vector: tapes of a few nodes are built for every
+        // stage of large scenes.
+        let mut slot: HashMap<Id, usize> = HashMap::with_capacity(order.len());
         let mut ops = Vec::with_capacity(order.len());
         for &id in &order {
-            let s = |x: Id| slot[x.index()];
+            let s = |x: Id| slot.get(&x).copied().unwrap_or(usize::MAX);
             let op = match arena.node(id) {
+                _ if cached.contains_key(&id) => Op::Cached(cached[&id]),
                 Node::Const(bits) => Op::Const(f64::from_bits(bits)),
                 Node::Param(i) => Op::Param(i as usize),
                 Node::Var(Var::Q(k)) => Op::Q(k as usize),
                 Node::Var(Var::Qd(k)) => Op::Qd(k as usize),
+                Node::Var(Var::Qdd(k)) => Op::Qdd(k as usize),
                 Node::Var(Var::T) => Op::T,
                 Node::Neg(a) => Op::Neg(s(a)),
                 Node::Add(a, b) => Op::Add(s(a), s(b)),
@@ -142,10 +165,13 @@ impl Tape {
                 Node::Powi(a, n) => Op::Powi(s(a), n),
                 Node::Call(f, a) => Op::Call(f, s(a)),
             };
-            slot[id.index()] = ops.len();
+            slot.insert(id, ops.len());
             ops.push(op);
         }
-        let outputs = roots.iter().map(|r| slot[r.index()]).collect();
+        let outputs = roots
+            .iter()
+            .map(|r| slot.get(r).copied().unwrap_or(usize::MAX))
+            .collect();
         Tape { ops, outputs }
     }
 
@@ -198,6 +224,8 @@ impl Tape {
                 Op::Param(p) => S::from_f64(inputs.params.get(p).copied().unwrap_or(f64::NAN)),
                 Op::Q(k) => get(inputs.q, k),
                 Op::Qd(k) => get(inputs.qd, k),
+                Op::Qdd(k) => get(inputs.qdd, k),
+                Op::Cached(k) => S::from_f64(inputs.trig.get(k).copied().unwrap_or(f64::NAN)),
                 Op::T => S::from_f64(inputs.t),
                 Op::Neg(a) => -scratch[a],
                 Op::Add(a, b) => scratch[a] + scratch[b],
@@ -218,7 +246,14 @@ impl Tape {
 /// Nodes reachable from `roots`, each once, every node after its operands. Deterministic:
 /// depends only on the DAG and the order of `roots`.
 pub fn topological_order(arena: &Arena, roots: &[Id]) -> Vec<Id> {
-    let mut visited = vec![false; arena.len()];
+    topological_order_with(arena, roots, |_| false)
+}
+
+/// [`topological_order`], with the nodes for which `leaf` holds taken as inputs: listed, but
+/// not their operands (unless another node needs them).
+pub fn topological_order_with(arena: &Arena, roots: &[Id], leaf: impl Fn(Id) -> bool) -> Vec<Id> {
+    // A set rather than an arena-sized vector: the cost follows the expressions, not the arena.
+    let mut visited = HashSet::new();
     let mut order = Vec::new();
     // Iterative post-order DFS: deep chains (large scenes) must not overflow the stack.
     let mut stack: Vec<(Id, bool)> = Vec::new();
@@ -229,14 +264,16 @@ pub fn topological_order(arena: &Arena, roots: &[Id]) -> Vec<Id> {
                 order.push(id);
                 continue;
             }
-            if visited[id.index()] {
+            if !visited.insert(id) {
                 continue;
             }
-            visited[id.index()] = true;
             stack.push((id, true));
+            if leaf(id) {
+                continue;
+            }
             let children: Vec<Id> = arena.children(id).collect();
             for child in children.into_iter().rev() {
-                if !visited[child.index()] {
+                if !visited.contains(&child) {
                     stack.push((child, false));
                 }
             }
@@ -265,6 +302,7 @@ mod tests {
         let env = Env {
             q: vec![0.5],
             qd: vec![],
+            qdd: vec![],
             t: 2.0,
             params: vec![3.0],
         };
@@ -339,6 +377,8 @@ mod tests {
         let inputs = Inputs {
             q: &[D(x0, 1.0)],
             qd: &[],
+            qdd: &[],
+            trig: &[],
             t: 0.0,
             params: &[p0],
         };
@@ -349,6 +389,7 @@ mod tests {
             &Env {
                 q: vec![x0],
                 qd: vec![],
+                qdd: vec![],
                 t: 0.0,
                 params: vec![p0],
             },

@@ -3,8 +3,9 @@
 //! The pipeline runs one way, one module per stage:
 //!
 //! ```text
-//! tokens / .mech ─parse─▶ Spec ─check─▶ Model ─kinematics─▶ Φ, Φ_q, ν, γ (IR) ─emit─▶ Rust tokens
-//!                                                                  └─interpret─▶ numbers
+//! tokens / .mech ─parse─▶ Spec ─check─▶ Model ─kinematics─▶ Φ, Φ_q, ν, γ (IR) ─structure─▶ Plan
+//!                                                  ─emit─▶ Rust tokens
+//!                                                  └─interpret─▶ numbers
 //! ```
 //!
 //! [`expand`] is that pipeline; the `mechanism!` macro (crate `mechgen-macros`) is a thin
@@ -18,6 +19,8 @@ pub mod diff;
 pub mod emit;
 pub mod error;
 pub mod expr;
+pub mod factor;
+pub mod graph;
 pub mod interpret;
 pub mod kinematics;
 pub mod limits;
@@ -25,6 +28,7 @@ pub mod model;
 pub mod parse;
 pub mod spec;
 pub mod stats;
+pub mod structure;
 
 use proc_macro2::TokenStream;
 
@@ -33,13 +37,16 @@ pub use error::Errors;
 pub use kinematics::Kinematics;
 pub use model::Model;
 
-/// A checked model with its derived kinematics: everything needed to emit or interpret a scene.
+/// A checked model with its derived kinematics and solve structure: everything needed to emit
+/// or interpret a scene.
 #[derive(Clone)]
 pub struct Scene {
     /// The checked model; its arena also holds the derived expressions.
     pub model: Model,
     /// Φ, Φ_q, ν, γ and the initial guess.
     pub kinematics: Kinematics,
+    /// The stages of the solve: explicit assignments and Newton blocks with their static LU.
+    pub plan: structure::Plan,
 }
 
 /// Parses, checks and differentiates a spec given as tokens.
@@ -61,9 +68,21 @@ pub fn compile_str(source: &str) -> Result<Scene, Errors> {
 }
 
 fn scene(spec: &spec::Spec) -> Result<Scene, Errors> {
-    let mut model = check::check(spec)?;
-    let kinematics = kinematics::derive(&mut model);
-    Ok(Scene { model, kinematics })
+    let model = check::check(spec)?;
+    Ok(Scene::derive(model))
+}
+
+impl Scene {
+    /// The stages after `check`: kinematics, then the solve structure.
+    fn derive(mut model: Model) -> Self {
+        let kinematics = kinematics::derive(&mut model);
+        let plan = structure::plan(&mut model, &kinematics);
+        Scene {
+            model,
+            kinematics,
+            plan,
+        }
+    }
 }
 
 /// The whole pipeline: spec tokens to generated Rust tokens.
@@ -72,7 +91,7 @@ fn scene(spec: &spec::Spec) -> Result<Scene, Errors> {
 /// As [`compile`].
 pub fn expand(tokens: TokenStream) -> Result<TokenStream, Errors> {
     let scene = compile(tokens)?;
-    Ok(emit::emit(&scene.model, &scene.kinematics))
+    Ok(emit::emit(&scene))
 }
 
 /// [`expand`] for the proc macro: errors become `compile_error!`s at their spans, and a panic in
@@ -103,9 +122,8 @@ pub fn compile_str_with(source: &str, options: &emit::CodegenOptions) -> Result<
     } else {
         expr::Arena::new()
     };
-    let mut model = check::check_into(&spec, arena)?;
-    let kinematics = kinematics::derive(&mut model);
-    Ok(Scene { model, kinematics })
+    let model = check::check_into(&spec, arena)?;
+    Ok(Scene::derive(model))
 }
 
 /// Generated code for a `.mech` source with explicit options, as tokens: what a `build.rs`
@@ -118,7 +136,7 @@ pub fn expand_str_with(
     options: &emit::CodegenOptions,
 ) -> Result<TokenStream, Errors> {
     let scene = compile_str_with(source, options)?;
-    Ok(emit::emit_with(&scene.model, &scene.kinematics, options))
+    Ok(emit::emit_with(&scene, options))
 }
 
 /// Generated code for a `.mech` source, formatted for reading (CLI `expand`, snapshots).
@@ -128,7 +146,7 @@ pub fn expand_str_with(
 #[cfg(feature = "pretty")]
 pub fn expand_pretty(source: &str) -> Result<String, Errors> {
     let scene = compile_str(source)?;
-    Ok(pretty(emit::emit(&scene.model, &scene.kinematics)))
+    Ok(pretty(emit::emit(&scene)))
 }
 
 /// Formats generated tokens with prettyplease.

@@ -5,8 +5,11 @@
 //! runs without a heap. The `alloc` feature adds dynamically sized mechanisms (used by the
 //! interpreter behind the `mechgen` CLI), which allocate once when the solver is built.
 //!
-//! [`Solver`] solves one instant ([`Solver::solve`]); [`Simulation`] steps through time with a
-//! warm-started predictor. Failures are [`SolveError`]s; [`SolveError::describe`] names the
+//! A scene hands the solver its equations ([`Mechanism`]) and the structure of their solve
+//! ([`Structured`]): explicit assignments and small Newton blocks in dependency order, each
+//! block's sparse factorisation fixed at generation time. [`Solver`] solves one instant
+//! ([`Solver::solve`]); [`Simulation`] steps through time with a warm-started predictor;
+//! [`Dense`] solves any mechanism as one dense block (the reference). Failures are [`SolveError`]s; [`SolveError::describe`] names the
 //! equations and coordinates involved. [`State::write_csv_row`] writes results without a heap.
 #![no_std]
 // The runtime must build without std or alloc: catch `std::` paths that `core::` provides.
@@ -18,6 +21,8 @@ extern crate alloc;
 #[cfg(test)]
 extern crate std;
 
+mod block;
+mod dense;
 mod error;
 mod lu;
 pub mod math;
@@ -28,15 +33,22 @@ mod position;
 mod simulate;
 mod solver;
 mod state;
+mod structure;
+mod workspace;
 
+pub use dense::{Dense, DenseBuffers};
 pub use error::{Described, Quantity, SolveError};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use mechanism::{
     Accelerations, Matrix, Mechanism, Outputs, ParameterError, Storage, Unit, Vector, Velocities,
 };
 pub use simulate::{Simulation, sample_time};
-pub use solver::{Convergence, Solver, SolverOptions, solve_accelerations, solve_velocities};
+pub use solver::{Convergence, Solver, SolverOptions};
 pub use state::{BodyState, Pose, PoseVelocity, State, write_csv_header};
+pub use structure::{Block, Pattern, Stage, Structured};
+#[cfg(feature = "alloc")]
+pub use workspace::VecBuffers;
+pub use workspace::{Buffers, Parts, Workspace};
 
 /// Re-exported so generated code and users name one crate.
 pub use nalgebra;

@@ -300,12 +300,13 @@ where
         let condition = if n == 0 {
             1.0
         } else {
+            let (a, swaps) = (self.lu.as_slice(), self.swaps.as_slice());
             let (inverse_norm, column) = inverse_one_norm_estimate(
-                self.lu.as_slice(),
-                self.swaps.as_slice(),
                 self.estimate_x.as_mut_slice(),
                 self.estimate_signs.as_mut_slice(),
                 self.estimate_hint.filter(|&j| j < n),
+                |x| solve_factors(a, swaps, x),
+                |x| solve_transposed_factors(a, swaps, x),
             );
             self.estimate_hint = Some(column);
             let condition = inverse_norm * self.norm1;
@@ -351,54 +352,13 @@ where
         self.invalidate();
         self.revealed_rank = None;
         self.load_scaled(rows, cols, fill)?;
-        let n = self.swaps.nrows();
-        let a = self.lu.as_mut_slice();
-        let Some(largest) = max_abs_if_finite(a) else {
-            return Err(LuError::NonFinite);
-        };
-        let threshold = tolerance * largest;
-        let row_order = self.row_order.as_mut_slice();
-        let col_order = self.col_order.as_mut_slice();
-        for (i, (row, col)) in row_order.iter_mut().zip(col_order.iter_mut()).enumerate() {
-            (*row, *col) = (i, i);
-        }
-
-        let mut rank = n;
-        for k in 0..n {
-            // Largest entry of the trailing submatrix (first one on ties, for stable reports).
-            let (mut pivot_row, mut pivot_col, mut best) = (k, k, 0.0_f64);
-            let mut finite = true;
-            for (j, column) in a.chunks_exact(n).enumerate().skip(k) {
-                for (i, &x) in column.iter().enumerate().skip(k) {
-                    let magnitude = x.abs();
-                    finite &= magnitude <= f64::MAX;
-                    if magnitude > best {
-                        (pivot_row, pivot_col, best) = (i, j, magnitude);
-                    }
-                }
-            }
-            if !finite {
-                return Err(LuError::NonFinite);
-            }
-            if best <= threshold || best == 0.0 {
-                rank = k;
-                break;
-            }
-            if pivot_row != k {
-                for column in a.chunks_exact_mut(n) {
-                    column.swap(k, pivot_row);
-                }
-                row_order.swap(k, pivot_row);
-            }
-            if pivot_col != k {
-                let (left, right) = a.split_at_mut(pivot_col * n);
-                left[k * n..(k + 1) * n].swap_with_slice(&mut right[..n]);
-                col_order.swap(k, pivot_col);
-            }
-            eliminate_step(a, n, k);
-        }
-        row_order[rank..].sort_unstable();
-        col_order[rank..].sort_unstable();
+        let rank = reveal_rank_in_place(
+            self.lu.as_mut_slice(),
+            self.row_order.as_mut_slice(),
+            self.col_order.as_mut_slice(),
+            tolerance,
+            0.0,
+        )?;
         self.revealed_rank = Some(rank);
         Ok(rank)
     }
@@ -492,45 +452,14 @@ where
 
     /// Factors the (already scaled) storage with partial pivoting; the shape is checked.
     fn eliminate(&mut self) -> Result<(), LuError> {
-        let n = self.swaps.nrows();
-        // Plain slices, column-major (a[i + j·n] is row i, column j): nalgebra's element
-        // iterators and tuple indexing cost an order of magnitude more in these loops.
-        let a = self.lu.as_mut_slice();
-        let Some((largest, norm1)) = max_abs_and_one_norm_if_finite(a, n) else {
-            return Err(LuError::NonFinite);
-        };
-        self.norm1 = norm1;
-        // `n as f64` is exact for any size that fits in memory.
-        let threshold = self.pivot_tolerance * n as f64 * largest;
-        let (mut min_pivot, mut max_pivot) = (f64::INFINITY, 0.0_f64);
-
-        for k in 0..n {
-            let column_k = k * n;
-            let (mut pivot_row, mut best) = (k, a[column_k + k].abs());
-            for i in k + 1..n {
-                let candidate = a[column_k + i].abs();
-                if candidate > best {
-                    (pivot_row, best) = (i, candidate);
-                }
-            }
-            // An exact zero is singular whatever the tolerance (even a NaN or negative one).
-            if best <= threshold || best == 0.0 {
-                return Err(LuError::Singular {
-                    row: self.likeliest_dependent_row(k),
-                    column: k,
-                    pivot: best,
-                });
-            }
-            self.swaps[k] = pivot_row;
-            if pivot_row != k {
-                for j in 0..n {
-                    a.swap(j * n + k, j * n + pivot_row);
-                }
-            }
-            (min_pivot, max_pivot) = (min_pivot.min(best), max_pivot.max(best));
-            eliminate_step(a, n, k);
-        }
-        self.pivot_range = Some((min_pivot, max_pivot));
+        let factored = factor_in_place(
+            self.lu.as_mut_slice(),
+            self.swaps.as_mut_slice(),
+            self.pivot_tolerance,
+            0.0,
+        )?;
+        self.norm1 = factored.norm1;
+        self.pivot_range = Some((factored.min_pivot, factored.max_pivot));
         Ok(())
     }
 
@@ -548,29 +477,157 @@ where
         }
         Ok(b.as_mut_slice())
     }
+}
 
-    /// Among rows `k..n` after `k` elimination steps, the original index of the one whose
-    /// remaining entries are smallest: it is (nearly) a combination of the pivot rows already used.
-    fn likeliest_dependent_row(&self, k: usize) -> usize {
-        let n = self.lu.nrows();
-        let mut best = (k, f64::INFINITY);
-        for i in k..n {
-            let size = (k..n).fold(0.0_f64, |m, j| m.max(self.lu[(i, j)].abs()));
-            if size < best.1 {
-                best = (i, size);
+/// Pivot statistics of a successful [`factor_in_place`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Factored {
+    /// `‖S‖₁` before elimination.
+    pub norm1: f64,
+    /// Smallest and largest pivot magnitude.
+    pub min_pivot: f64,
+    pub max_pivot: f64,
+}
+
+/// `P S = L U` with partial pivoting, in place on the column-major n × n `a` (n = `swaps.len()`,
+/// `a.len() == n²`); a pivot is unusable when `|u_kk| ≤ tolerance · n · max(floor, max|s_ij|)`
+/// (`floor` is the scale below which entries count as small: 0 for a matrix on its own, 1 for a
+/// block of a unit-scaled Jacobian, whose other blocks hold entries of 1).
+///
+/// # Errors
+/// [`LuError::NonFinite`] for a NaN or infinite entry, [`LuError::Singular`] for a column without
+/// a usable pivot (its `row` is the likeliest dependent equation).
+pub(crate) fn factor_in_place(
+    a: &mut [f64],
+    swaps: &mut [usize],
+    tolerance: f64,
+    floor: f64,
+) -> Result<Factored, LuError> {
+    let n = swaps.len();
+    // Plain slices, column-major (a[i + j·n] is row i, column j): nalgebra's element
+    // iterators and tuple indexing cost an order of magnitude more in these loops.
+    let Some((largest, norm1)) = max_abs_and_one_norm_if_finite(a, n) else {
+        return Err(LuError::NonFinite);
+    };
+    // `n as f64` is exact for any size that fits in memory.
+    let threshold = tolerance * n as f64 * largest.max(floor);
+    let (mut min_pivot, mut max_pivot) = (f64::INFINITY, 0.0_f64);
+    for k in 0..n {
+        let column_k = k * n;
+        let (mut pivot_row, mut best) = (k, a[column_k + k].abs());
+        for i in k + 1..n {
+            let candidate = a[column_k + i].abs();
+            if candidate > best {
+                (pivot_row, best) = (i, candidate);
             }
         }
-        // Undo the swaps of steps 0..k to find where that row started.
-        let mut row = best.0;
-        for (step, &swap) in self.swaps.iter().enumerate().take(k).rev() {
-            if row == step {
-                row = swap;
-            } else if row == swap {
-                row = step;
+        // An exact zero is singular whatever the tolerance (even a NaN or negative one).
+        if best <= threshold || best == 0.0 {
+            return Err(LuError::Singular {
+                row: likeliest_dependent_row(a, swaps, k),
+                column: k,
+                pivot: best,
+            });
+        }
+        swaps[k] = pivot_row;
+        if pivot_row != k {
+            for j in 0..n {
+                a.swap(j * n + k, j * n + pivot_row);
             }
         }
-        row
+        (min_pivot, max_pivot) = (min_pivot.min(best), max_pivot.max(best));
+        eliminate_step(a, n, k);
     }
+    Ok(Factored {
+        norm1,
+        min_pivot,
+        max_pivot,
+    })
+}
+
+/// Among rows `k..n` after `k` elimination steps of [`factor_in_place`], the original index of
+/// the one whose remaining entries are smallest: it is (nearly) a combination of the pivot rows
+/// already used.
+fn likeliest_dependent_row(a: &[f64], swaps: &[usize], k: usize) -> usize {
+    let n = swaps.len();
+    let mut best = (k, f64::INFINITY);
+    for i in k..n {
+        let size = (k..n).fold(0.0_f64, |m, j| m.max(a[i + j * n].abs()));
+        if size < best.1 {
+            best = (i, size);
+        }
+    }
+    // Undo the swaps of steps 0..k to find where that row started.
+    let mut row = best.0;
+    for (step, &swap) in swaps.iter().enumerate().take(k).rev() {
+        if row == step {
+            row = swap;
+        } else if row == swap {
+            row = step;
+        }
+    }
+    row
+}
+
+/// Gaussian elimination with complete pivoting of the column-major n × n `a` (n =
+/// `row_order.len()`) until every remaining entry is at most `tolerance · max(floor, max|a_ij|)`
+/// (or exactly zero); returns that numerical rank `r`. `row_order[k]` / `col_order[k]` receive the original
+/// index of the `k`-th pivot row / column; the tails past the rank are sorted.
+///
+/// # Errors
+/// [`LuError::NonFinite`] for a NaN or infinite entry (also if elimination overflows).
+pub(crate) fn reveal_rank_in_place(
+    a: &mut [f64],
+    row_order: &mut [usize],
+    col_order: &mut [usize],
+    tolerance: f64,
+    floor: f64,
+) -> Result<usize, LuError> {
+    let n = row_order.len();
+    let Some(largest) = max_abs_if_finite(a) else {
+        return Err(LuError::NonFinite);
+    };
+    let threshold = tolerance * largest.max(floor);
+    for (i, (row, col)) in row_order.iter_mut().zip(col_order.iter_mut()).enumerate() {
+        (*row, *col) = (i, i);
+    }
+    let mut rank = n;
+    for k in 0..n {
+        // Largest entry of the trailing submatrix (first one on ties, for stable reports).
+        let (mut pivot_row, mut pivot_col, mut best) = (k, k, 0.0_f64);
+        let mut finite = true;
+        for (j, column) in a.chunks_exact(n).enumerate().skip(k) {
+            for (i, &x) in column.iter().enumerate().skip(k) {
+                let magnitude = x.abs();
+                finite &= magnitude <= f64::MAX;
+                if magnitude > best {
+                    (pivot_row, pivot_col, best) = (i, j, magnitude);
+                }
+            }
+        }
+        if !finite {
+            return Err(LuError::NonFinite);
+        }
+        if best <= threshold || best == 0.0 {
+            rank = k;
+            break;
+        }
+        if pivot_row != k {
+            for column in a.chunks_exact_mut(n) {
+                column.swap(k, pivot_row);
+            }
+            row_order.swap(k, pivot_row);
+        }
+        if pivot_col != k {
+            let (left, right) = a.split_at_mut(pivot_col * n);
+            left[k * n..(k + 1) * n].swap_with_slice(&mut right[..n]);
+            col_order.swap(k, pivot_col);
+        }
+        eliminate_step(a, n, k);
+    }
+    row_order[rank..].sort_unstable();
+    col_order[rank..].sort_unstable();
+    Ok(rank)
 }
 
 /// Elimination step `k` on column-major `a` (n × n) whose pivot is already at `(k, k)`:
@@ -608,7 +665,7 @@ fn scale_slice(x: &mut [f64], scale: &[f64]) {
 ///
 /// The caller guarantees `a.len() == n²` and `swaps.len() == n == x.len()`, `swaps[k] < n`.
 #[inline(always)]
-fn solve_factors(a: &[f64], swaps: &[usize], x: &mut [f64]) {
+pub(crate) fn solve_factors(a: &[f64], swaps: &[usize], x: &mut [f64]) {
     // Index loops over `n = x.len()`, as in the original solve: once inlined for a `Const`
     // dimension, `n` is a constant and these compile to straight-line code (the iterator
     // form measured ~40% slower on a 15 × 15 system).
@@ -642,7 +699,7 @@ fn solve_factors(a: &[f64], swaps: &[usize], x: &mut [f64]) {
 /// `y = Pᵀ w`, i.e. the swaps in reverse order. Row `k` of `Uᵀ` (of `Lᵀ`) is column `k` of `U`
 /// (of `L`), so both are contiguous dot products. Same preconditions as [`solve_factors`].
 #[inline(always)]
-fn solve_transposed_factors(a: &[f64], swaps: &[usize], x: &mut [f64]) {
+pub(crate) fn solve_transposed_factors(a: &[f64], swaps: &[usize], x: &mut [f64]) {
     let n = x.len();
     for k in 0..n {
         let column = &a[k * n..(k + 1) * n];
@@ -665,17 +722,16 @@ fn solve_transposed_factors(a: &[f64], swaps: &[usize], x: &mut [f64]) {
     }
 }
 
-/// Lower-bound estimate of `‖S⁻¹‖₁` from the packed factors of `P S = L U`: Higham's
-/// Algorithm 4.1 (LAPACK `dlacn2`), keeping the largest bound found, with the column of the
-/// bound. `x` and `signs` are n-long scratch, n ≥ 1; `hint` is a column to start from (warm
-/// start: no first power step, no alternating-sign test); `f64::INFINITY` if a solve produces a
-/// non-finite value.
-fn inverse_one_norm_estimate(
-    a: &[f64],
-    swaps: &[usize],
+/// Lower-bound estimate of `‖S⁻¹‖₁` given solves with `S` and `Sᵀ`: Higham's Algorithm 4.1
+/// (LAPACK `dlacn2`), keeping the largest bound found, with the column of the bound. `x` and
+/// `signs` are n-long scratch, n ≥ 1; `hint` is a column to start from (warm start: no first
+/// power step, no alternating-sign test); `f64::INFINITY` if a solve produces a non-finite value.
+pub(crate) fn inverse_one_norm_estimate(
     x: &mut [f64],
     signs: &mut [f64],
     hint: Option<usize>,
+    mut solve: impl FnMut(&mut [f64]),
+    mut solve_transposed: impl FnMut(&mut [f64]),
 ) -> (f64, usize) {
     let n = x.len();
     let (mut estimate, mut j) = match hint {
@@ -687,7 +743,7 @@ fn inverse_one_norm_estimate(
         None => {
             // 1.0 / n as the start vector: `n as f64` is exact for any size that fits in memory.
             x.fill(1.0 / n as f64);
-            solve_factors(a, swaps, x);
+            solve(x);
             let estimate = one_norm(x);
             if !estimate.is_finite() {
                 return (f64::INFINITY, 0);
@@ -699,7 +755,7 @@ fn inverse_one_norm_estimate(
                 *s_i = sign(*x_i);
                 *x_i = *s_i;
             }
-            solve_transposed_factors(a, swaps, x);
+            solve_transposed(x);
             let Some(j) = index_of_max_abs(x) else {
                 return (f64::INFINITY, 0);
             };
@@ -711,7 +767,7 @@ fn inverse_one_norm_estimate(
     loop {
         x.fill(0.0);
         x[j] = 1.0;
-        solve_factors(a, swaps, x);
+        solve(x);
         let latest = one_norm(x);
         if !latest.is_finite() {
             return (f64::INFINITY, j);
@@ -732,7 +788,7 @@ fn inverse_one_norm_estimate(
             *s_i = sign(*x_i);
             *x_i = *s_i;
         }
-        solve_transposed_factors(a, swaps, x);
+        solve_transposed(x);
         let last = j;
         let Some(next) = index_of_max_abs(x) else {
             return (f64::INFINITY, best);
@@ -755,7 +811,7 @@ fn inverse_one_norm_estimate(
         *x_i = alternating * (1.0 + i as f64 / last);
         alternating = -alternating;
     }
-    solve_factors(a, swaps, x);
+    solve(x);
     let alternative = 2.0 * one_norm(x) / (3.0 * n as f64);
     if !alternative.is_finite() {
         return (f64::INFINITY, best);
@@ -823,7 +879,7 @@ fn max_abs_if_finite(values: &[f64]) -> Option<f64> {
 /// sum non-finite, so the exact per-entry check runs only then (a column sum of finite entries
 /// that overflowed is not an error; it just gives an infinite 1-norm).
 #[inline(always)]
-fn max_abs_and_one_norm_if_finite(values: &[f64], n: usize) -> Option<(f64, f64)> {
+pub(crate) fn max_abs_and_one_norm_if_finite(values: &[f64], n: usize) -> Option<(f64, f64)> {
     if n == 0 {
         return Some((0.0, 0.0));
     }

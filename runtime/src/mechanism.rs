@@ -3,9 +3,6 @@
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector};
 
-use crate::error::SolveError;
-use crate::lu::Lu;
-
 /// A column of coordinates or equation values (`Const<N>` for generated scenes: on the stack).
 pub type Vector<D> = OVector<f64, D>;
 /// A square matrix over coordinates × equations, such as the Jacobian Φ_q.
@@ -84,9 +81,12 @@ impl Unit {
 /// declaration order (ground bodies, joints, drivers). The system is square: `dim()` coordinates and
 /// `dim()` equations. Implementations are straight-line code: they must not allocate or panic.
 ///
-/// This trait covers positions. A scene that asked for velocities also implements [`Velocities`]
-/// (ν), and one that asked for accelerations [`Accelerations`] (γ), so asking for an output a
-/// scene left out is a compile error, not a run-time one.
+/// These are the textbook functions over all coordinates: the reviewable contract, and what the
+/// dense reference solve ([`crate::Dense`]) uses. The solver itself follows the scene's solve
+/// structure ([`crate::Structured`]). A scene that asked for velocities also implements the
+/// marker [`Velocities`] (and [`Mechanism::nu`]), one that asked for accelerations
+/// [`Accelerations`] (and [`Mechanism::gamma`]), so asking for an output a scene left out is a
+/// compile error, not a run-time one.
 pub trait Mechanism
 where
     DefaultAllocator: Storage<Self::Dim>,
@@ -176,43 +176,41 @@ where
     /// The outputs this scene computes.
     fn outputs(&self) -> Outputs;
 
-    /// Solves the time derivatives this scene provides at converged positions `q`, where
-    /// `factors` holds the LU of Φ_q(q): generated code calls [`crate::solve_velocities`] and
-    /// [`crate::solve_accelerations`] for the outputs it declares; a positions-only scene does
-    /// nothing. The solver calls this; users call [`crate::Solver::solve_into`].
+    /// Writes the velocity right-hand side ν = −Φ_t, so that Φ_q q̇ = ν.
     ///
-    /// # Errors
-    /// Those of the derivative solves ([`SolveError::NonFinite`] for ν, γ, q̇ or q̈).
-    fn derivatives(
+    /// Scenes that compute velocities ([`Outputs::Velocities`] or more) implement it; the
+    /// default writes NaN, and the solver never asks a scene for an output it did not declare.
+    fn nu(&self, _q: &Vector<Self::Dim>, _t: f64, out: &mut Vector<Self::Dim>) {
+        out.as_mut_slice().fill(f64::NAN);
+    }
+
+    /// Writes the acceleration right-hand side γ = −(Φ_q q̇)_q q̇ − 2 Φ_qt q̇ − Φ_tt, so that
+    /// Φ_q q̈ = γ.
+    ///
+    /// Scenes that compute accelerations implement it; the default writes NaN.
+    fn gamma(
         &self,
-        q: &Vector<Self::Dim>,
-        t: f64,
-        factors: &Lu<Self::Dim>,
-        qd: &mut Vector<Self::Dim>,
-        qdd: &mut Vector<Self::Dim>,
-    ) -> Result<(), SolveError>;
+        _q: &Vector<Self::Dim>,
+        _qd: &Vector<Self::Dim>,
+        _t: f64,
+        out: &mut Vector<Self::Dim>,
+    ) {
+        out.as_mut_slice().fill(f64::NAN);
+    }
 }
 
-/// A scene that computes velocities: Φ_q q̇ = ν.
+/// Marks a scene that computes velocities (implements [`Mechanism::nu`]): [`crate::State::qd`]
+/// and the velocity accessors exist only for such scenes, so asking a positions-only scene for
+/// velocities is a compile error.
 pub trait Velocities: Mechanism
 where
     DefaultAllocator: Storage<Self::Dim>,
 {
-    /// Writes the velocity right-hand side ν = −Φ_t, so that Φ_q q̇ = ν.
-    fn nu(&self, q: &Vector<Self::Dim>, t: f64, out: &mut Vector<Self::Dim>);
 }
 
-/// A scene that computes accelerations: Φ_q q̈ = γ.
+/// Marks a scene that computes accelerations (implements [`Mechanism::gamma`]).
 pub trait Accelerations: Velocities
 where
     DefaultAllocator: Storage<Self::Dim>,
 {
-    /// Writes the acceleration right-hand side γ = −(Φ_q q̇)_q q̇ − 2 Φ_qt q̇ − Φ_tt, so that Φ_q q̈ = γ.
-    fn gamma(
-        &self,
-        q: &Vector<Self::Dim>,
-        qd: &Vector<Self::Dim>,
-        t: f64,
-        out: &mut Vector<Self::Dim>,
-    );
 }

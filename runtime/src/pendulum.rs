@@ -6,13 +6,10 @@
 
 use nalgebra::Const;
 
-use crate::error::SolveError;
-use crate::lu::Lu;
 use crate::math::{cos, sin};
 use crate::mechanism::{
     Accelerations, Matrix, Mechanism, Outputs, ParameterError, Unit, Vector, Velocities,
 };
-use crate::solver::{solve_accelerations, solve_velocities};
 
 #[derive(Debug, Clone)]
 pub struct Pendulum {
@@ -116,27 +113,10 @@ impl Mechanism for Pendulum {
         Outputs::Accelerations
     }
 
-    fn derivatives(
-        &self,
-        q: &Vector<Self::Dim>,
-        t: f64,
-        factors: &Lu<Self::Dim>,
-        qd: &mut Vector<Self::Dim>,
-        qdd: &mut Vector<Self::Dim>,
-    ) -> Result<(), SolveError> {
-        solve_velocities(self, q, t, factors, qd)?;
-
-        solve_accelerations(self, q, qd, t, factors, qdd)
-    }
-}
-
-impl Velocities for Pendulum {
     fn nu(&self, _: &Vector<Const<3>>, _: f64, out: &mut Vector<Const<3>>) {
         *out = Vector::from([0.0, 0.0, self.omega]);
     }
-}
 
-impl Accelerations for Pendulum {
     fn gamma(
         &self,
         q: &Vector<Const<3>>,
@@ -150,6 +130,9 @@ impl Accelerations for Pendulum {
     }
 }
 
+impl Velocities for Pendulum {}
+impl Accelerations for Pendulum {}
+
 /// The same pendulum behind a `Dyn` dimension, as the interpreter would present it.
 #[cfg(feature = "alloc")]
 pub struct DynPendulum(pub Pendulum);
@@ -157,8 +140,7 @@ pub struct DynPendulum(pub Pendulum);
 #[cfg(feature = "alloc")]
 mod dynamic {
     use super::{
-        Accelerations, DynPendulum, Lu, Mechanism, Outputs, ParameterError, SolveError, Unit,
-        Vector, Velocities, solve_accelerations, solve_velocities,
+        Accelerations, DynPendulum, Mechanism, Outputs, ParameterError, Unit, Vector, Velocities,
     };
     use crate::mechanism::Matrix;
     use nalgebra::{Const, Dyn, Matrix3, Vector3};
@@ -220,33 +202,19 @@ mod dynamic {
             Outputs::Accelerations
         }
 
-        fn derivatives(
-            &self,
-            q: &Vector<Self::Dim>,
-            t: f64,
-            factors: &Lu<Self::Dim>,
-            qd: &mut Vector<Self::Dim>,
-            qdd: &mut Vector<Self::Dim>,
-        ) -> Result<(), SolveError> {
-            solve_velocities(self, q, t, factors, qd)?;
-
-            solve_accelerations(self, q, qd, t, factors, qdd)
-        }
-    }
-
-    impl Velocities for DynPendulum {
         fn nu(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
             let mut nu = Vector3::zeros();
             self.0.nu(&fixed(q), t, &mut nu);
             out.copy_from_slice(nu.as_slice());
         }
-    }
 
-    impl Accelerations for DynPendulum {
         fn gamma(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
             let mut gamma = Vector3::zeros();
             self.0.gamma(&fixed(q), &fixed(qd), t, &mut gamma);
             out.copy_from_slice(gamma.as_slice());
         }
     }
+
+    impl Velocities for DynPendulum {}
+    impl Accelerations for DynPendulum {}
 }

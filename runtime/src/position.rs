@@ -1,21 +1,37 @@
-//! The position solve: Newton–Raphson on the unit-scaled Φ(q, t) = 0, kept on track by a step
-//! clamp, a backtracking line search and Levenberg–Marquardt steps where Newton's cannot be
-//! used; and, when it fails, the diagnosis of why.
+//! The position solve of one block: Newton–Raphson on the block's unit-scaled equations, kept on
+//! track by a step clamp, a backtracking line search and Levenberg–Marquardt steps where
+//! Newton's cannot be used; and, when it fails, the diagnosis of why.
 //!
 //! The safeguards cost nothing on the usual path. A Newton step is applied without evaluating
 //! the trial point first; the next iteration's evaluation, needed anyway, doubles as the line
 //! search test, and only a step that failed to reduce the residual is taken back and shortened.
+//!
+//! A Newton iteration that crawls into its root (corrections shrinking linearly from a small
+//! residual) has found a singular one: a toggle position or redundant constraints
+//! ([`CRAWL_LIMIT`]).
+//!
+//! Stopping rule. A correction within `step_tolerance` ends the iteration when convergence is
+//! evident: the correction shrank to at most a quarter of the previous one (Newton's quadratic
+//! phase; a linearly converging iteration, as at a singular root, halves it at best), or, for
+//! the first correction, it was taken from a point whose residual was already within
+//! `residual_tolerance`. The correction is applied; its size bounds the error before it, so the
+//! error after it is of the order of its square. No confirming update follows. The factors the
+//! derivative solves need are those at the returned positions: when the last correction was of
+//! round-off size (≤ [`NEGLIGIBLE_STEP`]), the factors it was computed with are kept (the
+//! Jacobian moved by less than its own rounding); otherwise the block is evaluated and factored
+//! once more at the returned positions.
 
 use nalgebra::DefaultAllocator;
 
+use crate::block::{BlockSolve, Factors};
 use crate::error::{Quantity, SolveError};
-use crate::lu::LuError;
-use crate::mechanism::{Matrix, Mechanism, Outputs, Storage, Vector};
-use crate::solver::{
-    Convergence, Solver, check_finite, lu_error, max_abs, non_finite, scaled_max_abs,
-};
+use crate::lu::{self, LuError};
+use crate::mechanism::{Storage, Vector};
+use crate::solver::{SolverOptions, non_finite};
+use crate::structure::Structured;
+use crate::workspace::Parts;
 
-/// Armijo constant: a step of length α must reduce the merit ‖D_r Φ‖₂ by at least this · α.
+/// Armijo constant: a step of length α must reduce the merit ‖D_r Φ_b‖₂ by at least this · α.
 const SUFFICIENT_DECREASE: f64 = 1e-4;
 /// Shortest fraction of a Newton step tried before switching to Levenberg–Marquardt.
 const MIN_STEP_FRACTION: f64 = 1.0 / 64.0;
@@ -26,8 +42,23 @@ const SINGULAR_RESIDUAL: f64 = 1e-6;
 /// before the residual is declared a nonzero minimum ([`SolveError::NoAssembly`]).
 const STALL_LIMIT: usize = 4;
 const STALL_DECREASE: f64 = 1e-3;
+/// A correction at most this fraction of the previous one shows quadratic convergence.
+const CONTRACTION: f64 = 0.25;
+/// A full Newton correction at least this fraction of the previous one, taken where the scaled
+/// residual is already below [`SINGULAR_RESIDUAL`], is crawling: at a double root (a toggle
+/// position) Newton halves the error at every step instead of squaring it, and rounding then
+/// stops it about √ε away, where the Jacobian's condition is only ~1/√ε.
+const CRAWL_RATIO: f64 = 0.4;
+/// This many crawling corrections in a row identify a singular root ([`SolveError::Singular`]).
+/// A regular root crawls at most while its error exceeds four times its Jacobian's smallest
+/// singular value, so three in a row from a residual below [`SINGULAR_RESIDUAL`] need a
+/// condition above ~1e4 as well.
+const CRAWL_LIMIT: usize = 3;
+/// A last correction this small (scaled) moved the Jacobian by less than its own rounding: its
+/// factors serve the derivative solves at the returned positions.
+pub(crate) const NEGLIGIBLE_STEP: f64 = 8.0 * f64::EPSILON;
 
-/// Levenberg–Marquardt state carried across the iterations of one solve.
+/// Levenberg–Marquardt state carried across the iterations of one block's solve.
 #[derive(Default)]
 struct Marquardt {
     /// Damping μ (0: not yet chosen).
@@ -38,213 +69,312 @@ struct Marquardt {
     used: bool,
 }
 
-impl<M: Mechanism> Solver<M>
+/// A block solved at one time.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Solved {
+    /// Updates applied.
+    pub iterations: usize,
+    /// ‖Φ_b‖∞ at the last evaluation (unscaled): at the returned positions, or just before the
+    /// last (negligible) correction.
+    pub residual: f64,
+    /// Condition estimate κ₁ of the scaled block Jacobian (NaN if switched off).
+    pub condition: f64,
+    /// The factors at the returned positions.
+    pub factors: Factors,
+}
+
+/// One block's solve: the block, the workspace it runs in, and the solver's settings.
+pub(crate) struct Newton<'a, 'w, M> {
+    pub bs: BlockSolve<'a, M>,
+    pub parts: &'a mut Parts<'w>,
+    pub options: &'a SolverOptions,
+    pub t: f64,
+    /// Factorisations whose static pivots failed and were redone with partial pivoting.
+    pub fallbacks: usize,
+}
+
+impl<M: Structured> Newton<'_, '_, M>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
-    /// Newton–Raphson on Φ(q, t) = 0, starting from and overwriting `q`.
-    ///
-    /// Each iteration evaluates Φ and Φ_q at `q`, factors the unit-scaled Φ_q and steps.
-    /// Converged once a step within `step_tolerance` has been taken from a point within
-    /// `residual_tolerance` (both scaled); Φ_q is then evaluated and factored once more at the
-    /// returned `q`, so the residual reported is the true one, the kept factors are exactly those
-    /// of Φ_q(q) (for the derivative solves), and `q` is quadratically accurate.
-    ///
-    /// Safeguards: steps longer than `max_step` are shortened; a step that does not reduce
-    /// ‖D_r Φ‖₂ is halved down to 1/64, then replaced by a Levenberg–Marquardt step, as is a
-    /// step from an iterate where Φ_q is singular. At the solution the condition of the scaled
-    /// Φ_q must be below `max_condition`, and every branch invariant of the scene positive.
+    /// Newton–Raphson on the block's equations, from and into the block's coordinates of `q`
+    /// (earlier stages' coordinates are inputs), ending with the block's factors at the
+    /// returned positions when `factors_needed` (derivative solves follow).
     ///
     /// # Errors
-    /// [`SolveError::NonFinite`] for a non-finite `t`, parameter, guess, Φ, Φ_q or step;
-    /// [`SolveError::Singular`] at a solution where Φ_q is singular or too ill-conditioned (the
-    /// solver then lists every dependent equation: [`Solver::dependent_equations`]);
-    /// [`SolveError::NoAssembly`] when the residual stops decreasing above the tolerance;
-    /// [`SolveError::BranchFlip`] for a solution on another branch;
-    /// [`SolveError::NoConvergence`] after `max_iterations` updates. `q` holds the last iterate.
-    pub fn solve_position(
+    /// [`SolveError::NonFinite`] for a non-finite Φ, Φ_q or step; [`SolveError::Singular`] at a
+    /// solution where the block Jacobian is singular or too ill-conditioned (the diagnosis is
+    /// in the workspace's orders); [`SolveError::NoAssembly`] when the residual stops
+    /// decreasing above the tolerance; [`SolveError::NoConvergence`] after `max_iterations`.
+    pub fn solve(
         &mut self,
         q: &mut Vector<M::Dim>,
-        t: f64,
-    ) -> Result<Convergence, SolveError> {
-        self.check_inputs(t, q, Quantity::Guess)?;
-        self.check_parameters(t)?;
-        self.update_scales();
-        let options = self.options;
-        let (mut iterations, mut converged) = (0, false);
+        factors_needed: bool,
+    ) -> Result<Solved, SolveError> {
+        let options = *self.options;
+        let (mut iterations, mut finishing) = (0, false);
+        // Length of the last full Newton correction, for the contraction test, and how many
+        // corrections in a row crawled.
+        let mut previous: Option<f64> = None;
+        let mut crawls = 0;
         let mut marquardt = Marquardt::default();
         // The step last applied: merit at `base` and the fraction of the step taken.
         let mut pending: Option<(f64, f64)> = None;
         loop {
-            let factored = self.evaluate(q, t);
-            check_finite(&self.phi, t, Quantity::Phi)?;
-            let (merit, residual) = scaled_norms(&self.phi, &self.rows);
-            // Relative to the scaled coordinates' size as well: a crank that has turned for
-            // hours has θ ~ 1e6 rad, which no absolute angle tolerance near ε could resolve.
-            let magnitude = scaled_max(q, &self.cols).max(1.0);
+            let factored = self.evaluate(q);
+            self.check_phi()?;
+            let (merit, residual) = self.norms();
+            let magnitude = self.magnitude(q);
             let small = residual <= options.residual_tolerance * magnitude;
-
+            if finishing {
+                return match factored {
+                    Ok(factors) => self.finish(q, factors, iterations),
+                    Err(error) => Err(self.factor_error(q, error)),
+                };
+            }
             if let Some((base_merit, fraction)) = pending.take() {
                 let enough = merit <= (1.0 - SUFFICIENT_DECREASE * fraction) * base_merit;
                 if !small && (factored.is_err() || !enough) {
+                    previous = None;
                     if fraction > MIN_STEP_FRACTION {
                         self.retreat(q, fraction * 0.5);
                         pending = Some((base_merit, fraction * 0.5));
                         continue;
                     }
-                    q.copy_from(&self.base);
-                    self.marquardt_step(q, t, &mut marquardt, &mut iterations)?;
-                    converged = false;
+                    self.restore(q);
+                    self.marquardt_step(q, &mut marquardt, &mut iterations)?;
                     continue;
                 }
             }
-            match factored {
-                Ok(()) => {}
+            let factors = match factored {
+                Ok(factors) => factors,
                 Err(LuError::Singular { .. }) if residual <= SINGULAR_RESIDUAL => {
-                    return Err(self.diagnose(q, t, f64::INFINITY));
+                    return Err(self.diagnose(q, f64::INFINITY));
                 }
                 Err(LuError::Singular { .. }) => {
-                    self.marquardt_step(q, t, &mut marquardt, &mut iterations)?;
-                    converged = false;
+                    previous = None;
+                    self.marquardt_step(q, &mut marquardt, &mut iterations)?;
                     continue;
                 }
-                Err(error) => return Err(lu_error(error, t)),
-            }
-            if converged {
-                return self.accept(q, t, iterations);
-            }
+                Err(error) => return Err(self.factor_error(q, error)),
+            };
             if iterations >= options.max_iterations {
-                return Err(self.give_up(q, t, iterations, residual, &marquardt));
+                return Err(self.give_up(q, factors, iterations, residual, &marquardt));
             }
 
-            self.step.copy_from(&self.phi);
-            self.lu
-                .solve_in_place(&mut self.step)
-                .map_err(|error| lu_error(error, t))?;
-            // `step` now holds Φ_q⁻¹ Φ = −Δq.
-            let length = scaled_max(&self.step, &self.cols);
+            // step ← J⁻¹ Φ = −Δq.
+            let n = self.bs.n();
+            let newton = &mut self.parts.newton;
+            newton.step[..n].copy_from_slice(&newton.phi[..n]);
+            self.bs.solve(
+                factors,
+                &self.parts.factors,
+                &self.parts.scales,
+                self.parts.newton.step,
+            );
+            let length = scaled_max(&self.parts.newton.step[..n], self.parts.scales.cols);
             if !length.is_finite() {
-                return Err(non_finite(t, Quantity::Step));
+                return Err(non_finite(self.t, Quantity::Step));
             }
-            converged = small && length <= options.step_tolerance * magnitude;
             let fraction = if length > options.max_step {
                 options.max_step / length
             } else {
                 1.0
             };
-            self.base.copy_from(q);
+            let crawling = fraction == 1.0
+                && residual <= SINGULAR_RESIDUAL
+                && previous.is_some_and(|p| length >= CRAWL_RATIO * p);
+            crawls = if crawling { crawls + 1 } else { 0 };
+            if crawls >= CRAWL_LIMIT {
+                return Err(self.diagnose(q, f64::INFINITY));
+            }
+            let converged = length <= options.step_tolerance * magnitude
+                && previous.map_or(small, |p| length <= CONTRACTION * p);
+            previous = Some(length);
+            self.save_base(q);
             self.retreat(q, fraction);
             pending = Some((merit, fraction));
             iterations += 1;
-            // A positions-only scene needs no factors at the returned q (nothing solves with
-            // them): stop without the confirming evaluation; the residual reported is then the
-            // one before the last (tiny) step, an upper bound.
-            if converged && self.mechanism.outputs() == Outputs::Positions {
-                return self.accept(q, t, iterations);
+            if converged {
+                if !factors_needed || length <= NEGLIGIBLE_STEP {
+                    return self.finish(q, factors, iterations);
+                }
+                finishing = true;
             }
         }
     }
 
-    /// Evaluates Φ into `phi` and factors the scaled Φ_q at `q`.
-    fn evaluate(&mut self, q: &Vector<M::Dim>, t: f64) -> Result<(), LuError> {
-        let Self {
-            mechanism,
-            phi,
-            lu,
-            rows,
-            cols,
-            ..
-        } = self;
-        lu.factor_scaled_with(rows, cols, |jacobian| {
-            mechanism.phi_and_jacobian(q, t, phi, jacobian);
-        })
+    /// Evaluates Φ_b into `phi` and factors the scaled block Jacobian at `q`.
+    fn evaluate(&mut self, q: &Vector<M::Dim>) -> Result<Factors, LuError> {
+        let parts = &mut *self.parts;
+        let factored = self.bs.factor(
+            q,
+            parts.trig,
+            self.t,
+            parts.newton.phi,
+            &mut parts.factors,
+            &parts.scales,
+            parts.estimator.x,
+            self.options,
+        );
+        if factored.is_ok_and(Factors::fell_back) {
+            self.fallbacks += 1;
+        }
+        factored
     }
 
-    /// `q = base − fraction · step`.
-    fn retreat(&self, q: &mut Vector<M::Dim>, fraction: f64) {
-        let (base, step) = (self.base.as_slice(), self.step.as_slice());
-        for ((q, b), s) in q.as_mut_slice().iter_mut().zip(base).zip(step) {
-            *q = b - fraction * s;
+    /// The block's factors at given positions (for separate derivative solves).
+    ///
+    /// # Errors
+    /// [`SolveError::Singular`] with the diagnosis, or [`SolveError::NonFinite`] for the
+    /// Jacobian.
+    pub fn factor_at(&mut self, q: &Vector<M::Dim>) -> Result<Factors, SolveError> {
+        self.evaluate(q)
+            .map_err(|error| self.factor_error(q, error))
+    }
+
+    fn check_phi(&self) -> Result<(), SolveError> {
+        let n = self.bs.n();
+        if self.parts.newton.phi[..n].iter().all(|x| x.is_finite()) {
+            Ok(())
+        } else {
+            Err(non_finite(self.t, Quantity::Phi))
         }
     }
 
-    /// The checks at a converged `q`: condition and branch invariants.
-    fn accept(
+    /// (‖D_r Φ_b‖₂, ‖D_r Φ_b‖∞) of `phi`.
+    fn norms(&self) -> (f64, f64) {
+        let n = self.bs.n();
+        scaled_norms(&self.parts.newton.phi[..n], self.parts.scales.rows)
+    }
+
+    /// max(1, ‖D_c⁻¹ q_b‖∞): tolerances are relative to the size of the block's own
+    /// coordinates (a coupler that has turned for hours has θ ~ 1e6 rad, which no absolute
+    /// angle tolerance near ε could resolve; a huge angle elsewhere does not loosen this block).
+    fn magnitude(&self, q: &Vector<M::Dim>) -> f64 {
+        let q = q.as_slice();
+        let values = self.bs.block.coordinates.iter().map(|&j| q[j]);
+        scaled_max_iter(values, self.parts.scales.cols).max(1.0)
+    }
+
+    /// `base ← q_b`.
+    fn save_base(&mut self, q: &Vector<M::Dim>) {
+        let q = q.as_slice();
+        for (b, &j) in self
+            .parts
+            .newton
+            .base
+            .iter_mut()
+            .zip(self.bs.block.coordinates)
+        {
+            *b = q[j];
+        }
+    }
+
+    /// `q_b ← base`.
+    fn restore(&self, q: &mut Vector<M::Dim>) {
+        let q = q.as_mut_slice();
+        for (&b, &j) in self.parts.newton.base.iter().zip(self.bs.block.coordinates) {
+            q[j] = b;
+        }
+    }
+
+    /// `q_b = base − fraction · step`.
+    fn retreat(&self, q: &mut Vector<M::Dim>, fraction: f64) {
+        let q = q.as_mut_slice();
+        let newton = &self.parts.newton;
+        for ((&b, &s), &j) in newton
+            .base
+            .iter()
+            .zip(newton.step.iter())
+            .zip(self.bs.block.coordinates)
+        {
+            q[j] = b - fraction * s;
+        }
+    }
+
+    /// The check at a converged `q`: the condition of the factors kept.
+    fn finish(
         &mut self,
         q: &Vector<M::Dim>,
-        t: f64,
+        factors: Factors,
         iterations: usize,
-    ) -> Result<Convergence, SolveError> {
+    ) -> Result<Solved, SolveError> {
         let condition = if self.options.estimate_condition {
-            let condition = self.lu.condition_estimate().unwrap_or(f64::INFINITY);
+            let condition = self.condition(factors);
             if condition.is_nan() || condition > self.options.max_condition {
-                return Err(self.diagnose(q, t, condition));
+                return Err(self.diagnose(q, condition));
             }
             condition
         } else {
             f64::NAN
         };
-        let m = &self.mechanism;
-        for branch in 0..m.branch_count() {
-            let value = m.branch_value(branch, q);
-            if !value.is_finite() {
-                return Err(non_finite(t, Quantity::Branch(branch)));
-            }
-            if value <= 0.0 {
-                return Err(SolveError::BranchFlip {
-                    time: t,
-                    branch,
-                    value,
-                });
-            }
-        }
-        Ok(Convergence {
+        Ok(Solved {
             iterations,
-            residual: max_abs(&self.phi),
+            residual: max_abs(&self.parts.newton.phi[..self.bs.n()]),
             condition,
+            factors,
         })
+    }
+
+    /// Condition estimate of the current factors, warm-started from the block's last one.
+    pub fn condition(&mut self, factors: Factors) -> f64 {
+        let parts = &mut *self.parts;
+        let hint = &mut parts.hints[self.bs.stage];
+        self.bs
+            .condition(factors, &parts.factors, &mut parts.estimator, hint)
+    }
+
+    /// A failed factorisation at a (converged or given) `q`, as a solve error.
+    pub fn factor_error(&mut self, q: &Vector<M::Dim>, error: LuError) -> SolveError {
+        match error {
+            LuError::Singular { .. } => self.diagnose(q, f64::INFINITY),
+            _ => non_finite(self.t, Quantity::Jacobian),
+        }
     }
 
     /// Why a solve hit the iteration cap.
     fn give_up(
         &mut self,
         q: &Vector<M::Dim>,
-        t: f64,
+        factors: Factors,
         iterations: usize,
         residual: f64,
         marquardt: &Marquardt,
     ) -> SolveError {
         // Newton crawls into a singular root (linearly, not quadratically): name the cause.
         if residual <= SINGULAR_RESIDUAL {
-            let condition = self.lu.condition_estimate().unwrap_or(f64::INFINITY);
+            let condition = self.condition(factors);
             if condition.is_nan() || condition > self.options.max_condition {
-                return self.diagnose(q, t, condition);
+                return self.diagnose(q, condition);
             }
         }
         if marquardt.used {
-            self.no_assembly(q, t, iterations)
+            self.no_assembly(q, iterations)
         } else {
             SolveError::NoConvergence {
-                time: t,
+                time: self.t,
                 iterations,
-                residual: max_abs(&self.phi),
+                residual: max_abs(&self.parts.newton.phi[..self.bs.n()]),
             }
         }
     }
 
-    /// Why the residual stopped decreasing at `q` (whose Φ is in `phi`): above
+    /// Why the residual stopped decreasing at `q` (whose Φ_b is in `phi`): above
     /// [`SINGULAR_RESIDUAL`] the constraints cannot be met ([`SolveError::NoAssembly`]); below
-    /// it, `q` is (next to) a solution where Φ_q is singular, so Newton crawled instead of
-    /// converging: redundant constraints or a toggle position ([`SolveError::Singular`]).
-    fn no_assembly(&mut self, q: &Vector<M::Dim>, t: f64, iterations: usize) -> SolveError {
-        if scaled_norms(&self.phi, &self.rows).1 <= SINGULAR_RESIDUAL {
-            let condition = match self.evaluate(q, t) {
-                Ok(()) => self.lu.condition_estimate().unwrap_or(f64::INFINITY),
+    /// it, `q` is (next to) a solution where the Jacobian is singular, so Newton crawled
+    /// instead of converging: redundant constraints or a toggle position
+    /// ([`SolveError::Singular`]).
+    fn no_assembly(&mut self, q: &Vector<M::Dim>, iterations: usize) -> SolveError {
+        if self.norms().1 <= SINGULAR_RESIDUAL {
+            let condition = match self.evaluate(q) {
+                Ok(factors) => self.condition(factors),
                 Err(_) => f64::INFINITY,
             };
-            return self.diagnose(q, t, condition);
+            return self.diagnose(q, condition);
         }
-        let (rows, phi) = (self.rows.as_slice(), self.phi.as_slice());
+        let n = self.bs.n();
+        let (rows, phi) = (&self.parts.scales.rows[..n], &self.parts.newton.phi[..n]);
         let mut worst = (0, 0.0);
         for (i, (r, p)) in rows.iter().zip(phi).enumerate() {
             if (r * p).abs() > worst.1 {
@@ -252,57 +382,65 @@ where
             }
         }
         SolveError::NoAssembly {
-            time: t,
+            time: self.t,
             iterations,
-            residual: max_abs(&self.phi),
-            equation: worst.0,
+            residual: max_abs(phi),
+            equation: self.bs.block.equations.get(worst.0).copied().unwrap_or(0),
         }
     }
 
-    /// The rank-revealing diagnosis of a singular or ill-conditioned Φ_q at `q`: which
-    /// equations depend on the others, which coordinates they leave free.
-    fn diagnose(&mut self, q: &Vector<M::Dim>, t: f64, condition: f64) -> SolveError {
-        let n = self.phi.nrows();
+    /// The rank-revealing diagnosis of a singular or ill-conditioned block Jacobian at `q`:
+    /// which equations depend on the others, which coordinates they leave free (global indices
+    /// in the workspace's order buffers).
+    pub fn diagnose(&mut self, q: &Vector<M::Dim>, condition: f64) -> SolveError {
+        let n = self.bs.n();
         let floor = self.options.pivot_tolerance * n as f64;
         let mut tolerance = (1.0 / self.options.max_condition).max(floor);
-        let Self {
-            mechanism,
-            lu,
-            rows,
-            cols,
-            ..
-        } = self;
+        let parts = &mut *self.parts;
         // A condition above the limit but no pivot below the tolerance: widen until the
         // smallest pivots show (complete pivoting makes them track the small singular values).
         for _ in 0..8 {
-            match lu.reveal_rank(rows, cols, tolerance, |j| mechanism.jacobian(q, t, j)) {
-                Ok(rank) if rank < n => {
-                    let first = |indices: &[usize]| indices.first().copied().unwrap_or(0);
+            let revealed = self.bs.diagnose(
+                q,
+                parts.trig,
+                self.t,
+                parts.newton.phi,
+                parts.factors.values,
+                &parts.scales,
+                parts.estimator.x,
+                parts.dense,
+                parts.row_order,
+                parts.col_order,
+                tolerance,
+            );
+            match revealed {
+                Ok(0) => tolerance *= 10.0,
+                Ok(deficiency) => {
                     return SolveError::Singular {
-                        time: t,
-                        equation: first(lu.dependent_rows()),
-                        coordinate: first(lu.undetermined_columns()),
+                        time: self.t,
+                        equation: parts.row_order[0],
+                        coordinate: parts.col_order[0],
                         condition,
-                        deficiency: n - rank,
+                        deficiency,
                     };
                 }
-                Ok(_) => tolerance *= 10.0,
-                Err(error) => return lu_error(error, t),
+                Err(_) => return non_finite(self.t, Quantity::Jacobian),
             }
         }
         SolveError::Singular {
-            time: t,
-            equation: 0,
-            coordinate: 0,
+            time: self.t,
+            equation: self.bs.block.equations.first().copied().unwrap_or(0),
+            coordinate: self.bs.block.coordinates.first().copied().unwrap_or(0),
             condition,
             deficiency: 0,
         }
     }
 
     /// One accepted Levenberg–Marquardt step from `q`: solves (J_sᵀJ_s + μI) δ = J_sᵀ Φ_s on
-    /// the scaled system, raising μ until the step reduces ‖D_r Φ‖₂. Used where Newton's step
-    /// fails: at a singular Φ_q, or when its direction does not reduce the residual (far from
-    /// a solution, or where none exists, whose nonzero least-squares minimum it then finds).
+    /// the scaled block, raising μ until the step reduces ‖D_r Φ_b‖₂. Used where Newton's step
+    /// fails: at a singular Jacobian, or when its direction does not reduce the residual (far
+    /// from a solution, or where none exists, whose nonzero least-squares minimum it then
+    /// finds).
     ///
     /// # Errors
     /// [`SolveError::NoAssembly`] when no μ reduces the residual, or progress stalls, above the
@@ -310,83 +448,99 @@ where
     fn marquardt_step(
         &mut self,
         q: &mut Vector<M::Dim>,
-        t: f64,
         marquardt: &mut Marquardt,
         iterations: &mut usize,
     ) -> Result<(), SolveError> {
         marquardt.used = true;
+        let n = self.bs.n();
         if *iterations >= self.options.max_iterations {
-            self.mechanism.phi(q, t, &mut self.phi);
-            return Err(self.no_assembly(q, t, *iterations));
+            self.residual_at(q)?;
+            return Err(self.no_assembly(q, *iterations));
         }
+        // S = D_r J D_c into `dense`, Φ_b into `phi`.
         {
-            let Self {
-                mechanism,
-                phi,
-                jacobian,
-                ..
-            } = self;
-            mechanism.phi_and_jacobian(q, t, phi, jacobian);
+            let parts = &mut *self.parts;
+            let evaluated = self.bs.evaluate(
+                q,
+                parts.trig,
+                self.t,
+                parts.newton.phi,
+                parts.factors.values,
+                &parts.scales,
+                parts.estimator.x,
+            );
+            self.check_phi()?;
+            if evaluated.is_err() {
+                return Err(non_finite(self.t, Quantity::Jacobian));
+            }
+            let parts = &mut *self.parts;
+            self.bs
+                .scatter(parts.factors.values, &mut parts.dense[..n * n]);
         }
-        check_finite(&self.phi, t, Quantity::Phi)?;
-        if !self.jacobian.as_slice().iter().all(|x| x.is_finite()) {
-            return Err(non_finite(t, Quantity::Jacobian));
-        }
-        let (merit, residual) = scaled_norms(&self.phi, &self.rows);
+        let (merit, residual) = self.norms();
         if residual <= self.options.residual_tolerance {
             return Ok(());
         }
-        let largest = self.scale_jacobian_and_gradient();
+        let largest = self.gradient();
         if largest == 0.0 {
-            // Φ_q vanishes: no direction reduces the residual.
-            return Err(self.no_assembly(q, t, *iterations));
+            // The Jacobian vanishes: no direction reduces the residual.
+            return Err(self.no_assembly(q, *iterations));
         }
         if marquardt.mu == 0.0 {
             marquardt.mu = 1e-3 * largest;
         }
+        self.save_base(q);
         // μ beyond this leaves a step of round-off size: the residual is at a minimum.
         let mu_limit = 1e14 * largest;
         while marquardt.mu <= mu_limit {
             let mu = marquardt.mu;
-            let Self {
-                lu,
-                jacobian,
-                step,
-                gradient,
-                ..
-            } = self;
-            let factored = lu.factor_with(|a| normal_matrix(jacobian, mu, a));
-            if factored.is_ok() {
-                step.copy_from(gradient);
-                lu.solve_in_place(step)
-                    .map_err(|error| lu_error(error, t))?;
+            let parts = &mut *self.parts;
+            let (lu, swaps) = (
+                &mut parts.factors.lu[..n * n],
+                &mut parts.factors.swaps[..n],
+            );
+            normal_matrix(&parts.dense[..n * n], n, mu, lu);
+            let factored =
+                lu::factor_in_place(lu, swaps, self.options.pivot_tolerance, 0.0).is_ok();
+            let step = &mut parts.newton.step[..n];
+            if factored {
+                step.copy_from_slice(&parts.newton.gradient[..n]);
+                lu::solve_factors(lu, swaps, step);
             }
-            // Trial point q − D_c δ (δ clamped) into `base`, its Φ into `trial`.
-            let length = max_abs(&self.step);
+            // Trial point q_b = base − D_c δ (δ clamped), its Φ_b into `trial`.
+            let length = max_abs(step);
             let fraction = if length > self.options.max_step {
                 self.options.max_step / length
             } else {
                 1.0
             };
-            let trial_merit = if factored.is_ok() && length.is_finite() {
-                for (((b, x), s), c) in self
+            let trial_merit = if factored && length.is_finite() {
+                let qs = q.as_mut_slice();
+                for (((&b, &s), &c), &j) in parts
+                    .newton
                     .base
-                    .as_mut_slice()
-                    .iter_mut()
-                    .zip(q.as_slice())
-                    .zip(self.step.as_slice())
-                    .zip(self.cols.as_slice())
+                    .iter()
+                    .zip(step.iter())
+                    .zip(parts.scales.cols.iter())
+                    .zip(self.bs.block.coordinates)
                 {
-                    *b = x - fraction * s * c;
+                    qs[j] = b - fraction * s * c;
                 }
-                self.mechanism.phi(&self.base, t, &mut self.trial);
-                scaled_norms(&self.trial, &self.rows).0
+                self.bs.m.block_jacobian(
+                    self.bs.stage,
+                    q,
+                    parts.trig,
+                    self.t,
+                    &mut parts.newton.trial[..n],
+                    &mut parts.factors.values[..self.bs.block.slots],
+                );
+                scaled_norms(&parts.newton.trial[..n], parts.scales.rows).0
             } else {
                 f64::INFINITY
             };
             if trial_merit < merit {
-                q.copy_from(&self.base);
-                self.phi.copy_from(&self.trial);
+                let newton = &mut self.parts.newton;
+                newton.phi[..n].copy_from_slice(&newton.trial[..n]);
                 *iterations += 1;
                 marquardt.mu = (mu / 3.0).max(1e-12 * largest);
                 let progress = 1.0 - trial_merit / merit;
@@ -396,32 +550,44 @@ where
                     0
                 };
                 if marquardt.stalls >= STALL_LIMIT {
-                    return Err(self.no_assembly(q, t, *iterations));
+                    return Err(self.no_assembly(q, *iterations));
                 }
                 return Ok(());
             }
+            self.restore(q);
             marquardt.mu = mu * 4.0;
         }
-        Err(self.no_assembly(q, t, *iterations))
+        Err(self.no_assembly(q, *iterations))
     }
 
-    /// Scales `jacobian` in place to J_s = D_r J D_c, writes J_sᵀ (D_r Φ) into `gradient`, and
-    /// returns the largest diagonal entry of J_sᵀ J_s (the largest squared column norm).
-    fn scale_jacobian_and_gradient(&mut self) -> f64 {
-        let n = self.phi.nrows();
-        let (rows, cols, phi) = (
-            self.rows.as_slice(),
-            self.cols.as_slice(),
-            self.phi.as_slice(),
+    /// Φ_b at `q` into `phi` (the Jacobian values are overwritten and not used).
+    fn residual_at(&mut self, q: &Vector<M::Dim>) -> Result<(), SolveError> {
+        let n = self.bs.n();
+        let parts = &mut *self.parts;
+        self.bs.m.block_jacobian(
+            self.bs.stage,
+            q,
+            parts.trig,
+            self.t,
+            &mut parts.newton.phi[..n],
+            &mut parts.factors.values[..self.bs.block.slots],
         );
+        self.check_phi()
+    }
+
+    /// Writes J_sᵀ (D_r Φ_b) into `gradient` from the scaled dense Jacobian in `dense`, and
+    /// returns the largest diagonal entry of J_sᵀ J_s (the largest squared column norm).
+    fn gradient(&mut self) -> f64 {
+        let n = self.bs.n();
+        let parts = &mut *self.parts;
+        let (rows, phi) = (&parts.scales.rows[..n], &parts.newton.phi[..n]);
         let mut largest = 0.0_f64;
-        let columns = self.jacobian.as_mut_slice().chunks_exact_mut(n.max(1));
-        for ((column, c), g) in columns.zip(cols).zip(self.gradient.as_mut_slice()) {
+        let columns = parts.dense[..n * n].chunks_exact(n.max(1));
+        for (column, g) in columns.zip(parts.newton.gradient.iter_mut()) {
             let (mut dot, mut norm) = (0.0, 0.0);
-            for ((a, r), p) in column.iter_mut().zip(rows).zip(phi) {
-                *a *= r * c;
-                dot += *a * r * p;
-                norm += *a * *a;
+            for ((a, r), p) in column.iter().zip(rows).zip(phi) {
+                dot += a * r * p;
+                norm += a * a;
             }
             *g = dot;
             largest = largest.max(norm);
@@ -430,13 +596,8 @@ where
     }
 }
 
-/// `a = jᵀ j + μ I` (column-major slices; `j` is small or this is the rare fallback path).
-fn normal_matrix<D: nalgebra::Dim>(j: &Matrix<D>, mu: f64, a: &mut Matrix<D>)
-where
-    DefaultAllocator: Storage<D>,
-{
-    let n = j.nrows();
-    let (j, a) = (j.as_slice(), a.as_mut_slice());
+/// `a = jᵀ j + μ I` for the column-major n × n `j` (small, and the rare fallback path).
+fn normal_matrix(j: &[f64], n: usize, mu: f64, a: &mut [f64]) {
     for col in 0..n {
         let jc = &j[col * n..(col + 1) * n];
         for row in 0..n {
@@ -448,12 +609,9 @@ where
 }
 
 /// (‖D_r v‖₂, ‖D_r v‖∞).
-fn scaled_norms<D: nalgebra::Dim>(v: &Vector<D>, rows: &Vector<D>) -> (f64, f64)
-where
-    DefaultAllocator: Storage<D>,
-{
+pub(crate) fn scaled_norms(v: &[f64], rows: &[f64]) -> (f64, f64) {
     let (mut sum, mut max) = (0.0_f64, 0.0_f64);
-    for (x, r) in v.as_slice().iter().zip(rows.as_slice()) {
+    for (x, r) in v.iter().zip(rows) {
         let y = x * r;
         sum += y * y;
         max = max.max(y.abs());
@@ -461,10 +619,20 @@ where
     (libm::sqrt(sum), max)
 }
 
-/// ‖D_c⁻¹ v‖∞: a step or a position in scene lengths and radians.
-fn scaled_max<D: nalgebra::Dim>(v: &Vector<D>, cols: &Vector<D>) -> f64
-where
-    DefaultAllocator: Storage<D>,
-{
-    scaled_max_abs(v.as_slice().iter().copied(), cols)
+/// ‖D_c⁻¹ v‖∞: a step or a position in scene lengths and radians; a NaN entry makes it NaN, so
+/// that callers see a non-finite step rather than a small one.
+pub(crate) fn scaled_max(v: &[f64], cols: &[f64]) -> f64 {
+    scaled_max_iter(v.iter().copied(), cols)
+}
+
+fn scaled_max_iter(v: impl Iterator<Item = f64>, cols: &[f64]) -> f64 {
+    v.zip(cols).fold(0.0, |m, (x, c)| {
+        let y = (x / c).abs();
+        if y > m || y.is_nan() { y } else { m }
+    })
+}
+
+/// ‖v‖∞.
+pub(crate) fn max_abs(v: &[f64]) -> f64 {
+    v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }

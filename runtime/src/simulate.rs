@@ -4,12 +4,14 @@
 use nalgebra::DefaultAllocator;
 
 use crate::error::{Quantity, SolveError};
-use crate::mechanism::{Mechanism, Outputs, Storage, Vector};
+use crate::mechanism::{Outputs, Storage, Vector};
 use crate::solver::Solver;
 use crate::state::State;
+use crate::structure::Structured;
 
 /// A predicted step is suspect when Newton moved the solution further from the prediction than
-/// this fraction of the predicted motion: a second-order prediction is O(h³) off while the
+/// this fraction of the predicted motion (both measured on the Newton blocks' coordinates, the
+/// only ones a solve can move to another branch): a second-order prediction is O(h³) off while the
 /// motion is O(h), so only a step far too coarse for the motion, or a landing on the mirror
 /// branch, gets near it.
 const JUMP_FRACTION: f64 = 0.5;
@@ -24,7 +26,7 @@ pub const DEFAULT_MAX_HALVINGS: u32 = 10;
 ///
 /// Holds three states and swaps them, so stepping never allocates and a failed step leaves the
 /// last good state untouched.
-pub struct Simulation<M: Mechanism>
+pub struct Simulation<M: Structured>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
@@ -50,7 +52,7 @@ enum Outcome {
     Failed(SolveError),
 }
 
-impl<M: Mechanism> Simulation<M>
+impl<M: Structured> Simulation<M>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
@@ -112,15 +114,17 @@ where
     }
 
     /// Solves at `t`, starting Newton from a prediction when the predictor is on: the Taylor
-    /// expansion `q + q̇ h + ½ q̈ h²` (`h = t − t_last`) with the derivatives the scene computes,
-    /// or, for a positions-only scene, the secant through the last two solved positions. The
-    /// second-order guess is O(h³) off, so Newton typically needs one or two updates.
+    /// expansion `q + q̇ h + ½ q̈ h² + ⅙ q⃛ h³` (`h = t − t_last`) with the derivatives the scene
+    /// computes and one more from the difference with the previous state (the jerk from the
+    /// last two accelerations), or, for a positions-only scene, the secant through the last two
+    /// solved positions. The third-order guess is O(h⁴) off, so Newton typically needs two
+    /// updates, the second of round-off size (whose factors then serve the rates).
     ///
     /// When that solve fails in a way a shorter step may cure (no convergence, no assembly, a
     /// branch flip) or lands suspiciously far from the prediction (the mirror branch), the
     /// drivers are sub-stepped: the interval is halved, and halved again on failure, down to
     /// 2^-`max_halvings` of it, each sub-step predicted from the last. The state then records the
-    /// sub-steps taken ([`State::substeps`]) and all their Newton iterations.
+    /// sub-steps taken ([`State::substeps`]) and all their Newton iterations and fallbacks.
     ///
     /// # Errors
     /// The [`SolveError`] of the solve at `t`, or of the sub-step that could not be shortened
@@ -150,12 +154,13 @@ where
         let t_start = self.current.t;
         let shortest = (t_end - t_start).abs() / (1_u64 << self.max_halvings) as f64;
         let mut h = 0.5 * (t_end - t_start);
-        let (mut substeps, mut iterations, mut successes) = (0, 0, 0);
+        let (mut substeps, mut iterations, mut fallbacks, mut successes) = (0, 0, 0, 0);
         loop {
             let remaining = t_end - self.current.t;
             if remaining == 0.0 {
                 self.current.substeps = substeps;
                 self.current.iterations = iterations;
+                self.current.fallbacks = fallbacks;
                 return Ok(&self.current);
             }
             // Within a hair of the end, take the end exactly rather than leave a sliver.
@@ -170,6 +175,7 @@ where
             match self.advance(target, finest) {
                 Outcome::Solved => {
                     (substeps, iterations) = (substeps + 1, iterations + self.current.iterations);
+                    fallbacks += self.current.fallbacks;
                     successes += 1;
                     // Two good sub-steps in a row: try a longer one (never beyond half the step).
                     if successes >= 2 && 2.0 * h.abs() <= 0.5 * (t_end - t_start).abs() {
@@ -195,25 +201,37 @@ where
             current.velocities.as_slice(),
             current.accelerations.as_slice(),
         );
-        // Secant slope (q − q_prev)/h_prev for positions-only scenes, from the previous state
-        // still held in `next`.
+        // The previous state, still held in `next`, gives one more derivative by a difference:
+        // the secant slope for positions-only scenes, q̈ from two velocities, the jerk from two
+        // accelerations.
         let h_prev = current.t - next.t;
-        let secant = self.has_previous && h_prev != 0.0 && h_prev.is_finite();
+        let history = self.has_previous && h_prev != 0.0 && h_prev.is_finite();
         let outputs = current.outputs();
         let predicted = self.predictor
             && match outputs {
-                Outputs::Positions => secant,
+                Outputs::Positions => history,
                 Outputs::Velocities | Outputs::Accelerations => true,
             };
-        for (k, guess) in next.q.as_mut_slice().iter_mut().enumerate() {
+        let (qd_prev, qdd_prev) = (next.velocities.as_slice(), next.accelerations.as_slice());
+        let (h2, h3) = (0.5 * h * h, h * h * h / 6.0);
+        let ratio = h / h_prev;
+        let mut guesses = next.q.as_mut_slice().iter_mut();
+        for (k, guess) in guesses.by_ref().enumerate() {
             *guess = match outputs {
                 _ if !predicted => q[k],
-                Outputs::Accelerations => q[k] + h * qd[k] + 0.5 * h * h * qdd[k],
+                Outputs::Accelerations if history => {
+                    let jerk = (qdd[k] - qdd_prev[k]) / h_prev;
+                    q[k] + h * qd[k] + h2 * qdd[k] + h3 * jerk
+                }
+                Outputs::Accelerations => q[k] + h * qd[k] + h2 * qdd[k],
+                Outputs::Velocities if history => {
+                    q[k] + h * qd[k] + h2 * (qd[k] - qd_prev[k]) / h_prev
+                }
                 Outputs::Velocities => q[k] + h * qd[k],
-                Outputs::Positions => q[k] + (q[k] - *guess) * (h / h_prev),
+                Outputs::Positions => q[k] + (q[k] - *guess) * ratio,
             };
         }
-        let motion = self.solver.scaled_distance(&next.q, &current.q);
+        let motion = self.solver.block_distance(&next.q, &current.q);
         self.prediction.copy_from(&next.q);
         // From here `next` no longer holds the previous state, whatever the outcome.
         self.has_previous = false;
@@ -221,7 +239,7 @@ where
             return Outcome::Failed(error);
         }
         if predicted && !accept_jump {
-            let correction = self.solver.scaled_distance(&self.next.q, &self.prediction);
+            let correction = self.solver.block_distance(&self.next.q, &self.prediction);
             let options = self.solver.options();
             let floor = JUMP_FLOOR + 10.0 * (options.residual_tolerance + options.step_tolerance);
             if correction > JUMP_FRACTION * motion + floor {
@@ -272,6 +290,7 @@ pub fn sample_time(t0: f64, t_end: f64, steps: usize, k: usize) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dense::Dense;
     use crate::pendulum::Pendulum;
 
     #[test]
@@ -289,7 +308,8 @@ mod tests {
     }
 
     fn iterations(predictor: bool) -> usize {
-        let mut simulation = Simulation::new(Solver::new(Pendulum::default()), 0.0).unwrap();
+        let mut simulation =
+            Simulation::new(Solver::new(Dense::new(Pendulum::default())), 0.0).unwrap();
         simulation.set_predictor(predictor);
         let (mut total, mut calls, mut last_t) = (0, 0, 0.0);
         simulation
@@ -312,14 +332,15 @@ mod tests {
 
     #[test]
     fn failed_step_keeps_the_last_state_and_reports_its_time() {
-        let mut simulation = Simulation::new(Solver::new(Pendulum::default()), 0.0).unwrap();
+        let mut simulation =
+            Simulation::new(Solver::new(Dense::new(Pendulum::default())), 0.0).unwrap();
         simulation.step_to(0.5).unwrap();
-        simulation.solver_mut().mechanism_mut().a = f64::NAN;
+        simulation.solver_mut().mechanism_mut().inner_mut().a = f64::NAN;
         let error = simulation.step_to(0.75).unwrap_err();
         assert_eq!(error.time(), Some(0.75));
         assert_eq!(simulation.state().t, 0.5);
         assert!(simulation.step_to(f64::NAN).is_err());
-        simulation.solver_mut().mechanism_mut().a = 2.0;
+        simulation.solver_mut().mechanism_mut().inner_mut().a = 2.0;
         assert_eq!(simulation.step_to(1.0).unwrap().t, 1.0);
     }
 }

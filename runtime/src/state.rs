@@ -30,9 +30,13 @@ where
     /// Time steps this state took: 1, or more when [`crate::Simulation`] had to sub-step the
     /// drivers to get here (0 for a state not reached by stepping).
     pub substeps: usize,
-    /// Condition estimate κ₁ of the unit-scaled Φ_q at `q` (see [`crate::Lu::condition_estimate`]);
+    /// Largest condition estimate κ₁ of the unit-scaled block Jacobians at `q` (see
+    /// [`crate::Lu::condition_estimate`]);
     /// large near toggle positions. NaN when the solver's estimate is switched off.
     pub condition: f64,
+    /// Block factorisations whose static pivots were too small and were redone with partial
+    /// pivoting (see [`crate::SolverOptions::static_pivot_threshold`]), summed over sub-steps.
+    pub fallbacks: usize,
     /// What the scene computes, which decides the CSV columns.
     outputs: Outputs,
     // `fn() -> M` keeps `State` Send/Sync/Clone regardless of `M`.
@@ -116,6 +120,7 @@ where
             iterations: 0,
             substeps: 0,
             condition: f64::NAN,
+            fallbacks: 0,
             outputs: mechanism.outputs(),
             mechanism: PhantomData,
         }
@@ -130,6 +135,7 @@ where
         self.iterations = other.iterations;
         self.substeps = other.substeps;
         self.condition = other.condition;
+        self.fallbacks = other.fallbacks;
     }
 
     /// The outputs this state holds (its scene's).
@@ -263,6 +269,7 @@ where
             iterations: self.iterations,
             substeps: self.substeps,
             condition: self.condition,
+            fallbacks: self.fallbacks,
             outputs: self.outputs,
             mechanism: PhantomData,
         }
@@ -282,6 +289,7 @@ where
             .field("iterations", &self.iterations)
             .field("substeps", &self.substeps)
             .field("condition", &self.condition)
+            .field("fallbacks", &self.fallbacks)
             .field("outputs", &self.outputs)
             .finish()
     }

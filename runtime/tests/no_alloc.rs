@@ -11,7 +11,7 @@ use core::fmt::{self, Write};
 use core::sync::atomic::{AtomicUsize, Ordering};
 use std::alloc::System;
 
-use common::{Q, SliderCrank};
+use common::{Q, SliderCrank, reference};
 use mechgen_runtime::{Simulation, Solver, write_csv_header};
 
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
@@ -75,7 +75,7 @@ fn solving_and_stepping_never_allocate() {
     let before = ALLOCATIONS.load(Ordering::SeqCst);
     assert!(before > 0, "the counting allocator is not installed");
 
-    let mut solver = Solver::new(SliderCrank::default());
+    let mut solver = Solver::new(reference(SliderCrank::default()));
     let mut guess = Q::zeros();
     mechgen_runtime::Mechanism::initial_guess(solver.mechanism(), &mut guess);
     let state = solver.solve(0.25, &guess).expect("assembles");
@@ -100,6 +100,7 @@ fn solving_and_stepping_never_allocate() {
     simulation
         .solver_mut()
         .mechanism_mut()
+        .inner_mut()
         .parameters
         .copy_from_slice(&[1.0, 0.5, 2.0, 0.3]);
     let unreachable = simulation.step_to(3.9).unwrap_err();

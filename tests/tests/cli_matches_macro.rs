@@ -3,7 +3,7 @@
 
 use mechgen_examples::scenes::{FourBar, PistonCrank};
 use mechgen_runtime::nalgebra::Const;
-use mechgen_runtime::{Mechanism, Simulation, Solver, write_csv_header};
+use mechgen_runtime::{Simulation, Solver, Structured, write_csv_header};
 
 /// Runs the `mechgen` command line in-process (the binary's `main` is a wrapper around this).
 fn cli_solve(file: &str, t_end: f64, steps: usize) -> String {
@@ -23,7 +23,7 @@ fn cli_solve(file: &str, t_end: f64, steps: usize) -> String {
 }
 
 /// The generated scene over the same times, written by the same CSV code.
-fn macro_solve<M: Mechanism<Dim = Const<N>>, const N: usize>(
+fn macro_solve<M: Structured<Dim = Const<N>>, const N: usize>(
     mechanism: M,
     t_end: f64,
     steps: usize,

@@ -4,12 +4,15 @@
 use mechgen_examples::accuracy::ErrorTracker;
 use mechgen_examples::closed_form;
 use mechgen_examples::scenes::{FourBar, PistonCrank};
-use mechgen_runtime::{Accelerations, Mechanism, Simulation, Solver, Vector, Velocities};
+use mechgen_runtime::{Accelerations, Mechanism, Simulation, Solver, Structured, Vector};
 
 /// The foundation's accuracy target: max error ≤ 1e-10 of each quantity's largest magnitude.
 const TOLERANCE: f64 = 1e-10;
 
-fn one_revolution<M: Accelerations<Dim = mechgen_runtime::nalgebra::Const<N>>, const N: usize>(
+fn one_revolution<
+    M: Structured<Dim = mechgen_runtime::nalgebra::Const<N>> + Accelerations,
+    const N: usize,
+>(
     mechanism: M,
     period: f64,
     exact: impl Fn(f64) -> closed_form::Kinematics<N>,

@@ -88,7 +88,7 @@ mechanism! {
 /// largest magnitude, as everywhere in the project).
 fn check<M, const N: usize>(mechanism: M, exact: impl Fn(f64) -> [[f64; N]; 3])
 where
-    M: mechgen_runtime::Accelerations<Dim = Const<N>>,
+    M: mechgen_runtime::Structured<Dim = Const<N>> + mechgen_runtime::Accelerations,
 {
     let mut simulation = Simulation::new(Solver::new(mechanism), 0.0).expect("assembles");
     let (mut error, mut scale) = ([0.0f64; 3], [0.0f64; 3]);

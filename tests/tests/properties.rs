@@ -4,7 +4,7 @@
 use mechgen_cli::Interpreted;
 use mechgen_examples::scenes::{FourBar, PistonCrank};
 use mechgen_runtime::nalgebra::{DMatrix, DVector, Dyn};
-use mechgen_runtime::{Accelerations, Matrix, Mechanism, Vector, Velocities};
+use mechgen_runtime::{Accelerations, Matrix, Mechanism, Vector};
 use proptest::prelude::*;
 
 fn interpreted(file: &str) -> Interpreted {

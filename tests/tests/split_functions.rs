@@ -3,7 +3,7 @@
 
 use mechgen_examples::scenes::PistonCrank;
 use mechgen_runtime::nalgebra::Const;
-use mechgen_runtime::{Accelerations, Matrix, Mechanism, Vector, Velocities};
+use mechgen_runtime::{Matrix, Mechanism, Vector};
 use proptest::prelude::*;
 
 // Only the kinematic functions are exercised; the scene's constants and accessors go unused.

@@ -6,7 +6,7 @@
 use mechgen_cli::Interpreted;
 use mechgen_examples::scenes::{FourBar, OffsetSlider, PistonCrank};
 use mechgen_runtime::nalgebra::{Const, DVector};
-use mechgen_runtime::{Mechanism, Simulation, Solver, Unit, Vector};
+use mechgen_runtime::{Mechanism, Simulation, Solver, Structured, Unit, Vector};
 
 fn interpreted(file: &str) -> Interpreted {
     let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
@@ -41,7 +41,7 @@ fn assert_same_metadata<M: Mechanism<Dim = Const<N>>, const N: usize>(
 
 /// The branch values along one period, from generated code, checked against the interpreter
 /// and returned.
-fn branch_values_along_motion<M: Mechanism<Dim = Const<N>> + Clone, const N: usize>(
+fn branch_values_along_motion<M: Structured<Dim = Const<N>> + Clone, const N: usize>(
     generated: M,
     interpreted: &Interpreted,
     period: f64,

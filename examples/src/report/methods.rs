@@ -1,16 +1,20 @@
 //! The ways of solving the report compares, as mechanisms behind the runtime's traits: the same
-//! Newton loop, LU and stepping run all of them, so only the Jacobian (and, for the interpreter,
-//! code generation itself) differs.
+//! Newton loop and stepping run all of them.
 //!
-//! - [`Method::Generated`]: the scene's generated code (analytic Φ_q, emitted straight-line).
-//! - [`ForwardDifference`] / [`CentralDifference`]: Φ_q by finite differences of the generated Φ.
+//! - [`Method::Generated`]: the scene's generated code, solved with its structure (explicit
+//!   assignments, small Newton blocks, static sparse LU): the product.
+//! - [`Method::Dense`]: the same generated Φ, Φ_q, ν, γ solved as one dense block with partial
+//!   pivoting ([`mechgen_runtime::Dense`]): what the structure saves.
+//! - [`ForwardDifference`] / [`CentralDifference`]: Φ_q by finite differences of the generated Φ,
+//!   solved densely.
 //! - [`AutoDiff`]: Φ_q by forward-mode automatic differentiation (num-dual's `Dual64`) of the
-//!   scene's Φ, evaluated from its IR by the interpreter's tape over dual numbers.
-//! - [`Method::Interpreted`]: `mechgen_cli::Interpreted`, everything (Φ, Φ_q, ν, γ) interpreted
-//!   from the IR, as a run-time (non-generated) library would do.
+//!   scene's Φ, evaluated from its IR by the interpreter's tape over dual numbers, solved densely.
+//! - [`Method::Interpreted`]: `mechgen_cli::Interpreted`, the same plan as the generated code
+//!   with everything evaluated from the IR, as a run-time (non-generated) library would do.
 //!
 //! The wrappers take ν and γ (and the initial guess, names and parameters) from the generated
-//! scene they wrap: the comparison isolates the Jacobian.
+//! scene they wrap, and run through the dense reference, which only needs textbook functions:
+//! against [`Method::Dense`] the comparison isolates the Jacobian.
 
 use std::cell::RefCell;
 use std::ops::{Add, Div, Mul, Neg, Sub};
@@ -19,16 +23,18 @@ use mechgen::expr::Func;
 use mechgen::interpret::{Inputs, Scalar, Tape};
 use mechgen_runtime::nalgebra::{DefaultAllocator, Dim, U1};
 use mechgen_runtime::{
-    Accelerations, Lu, Matrix, Mechanism, Outputs, ParameterError, SolveError, Storage, Unit,
-    Vector, Velocities,
+    Accelerations, Matrix, Mechanism, Outputs, ParameterError, Storage, Unit, Vector, Velocities,
 };
 use num_dual::{Dual64, DualNum};
 
 /// One way of computing Φ_q (and, for the interpreter, everything else).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Method {
-    /// Generated code: the analytic Jacobian, emitted as straight-line Rust.
+    /// Generated code: the analytic Jacobian, emitted as straight-line Rust, solved with the
+    /// scene's structure.
     Generated,
+    /// The same generated functions, solved as one dense block.
+    Dense,
     /// Forward differences of the generated Φ.
     ForwardDifference,
     /// Central differences of the generated Φ.
@@ -41,8 +47,9 @@ pub enum Method {
 
 impl Method {
     /// Every method, in the order of the report's tables (generated first: the reference).
-    pub const ALL: [Method; 5] = [
+    pub const ALL: [Method; 6] = [
         Method::Generated,
+        Method::Dense,
         Method::ForwardDifference,
         Method::CentralDifference,
         Method::AutoDiff,
@@ -53,6 +60,7 @@ impl Method {
     pub fn label(self) -> &'static str {
         match self {
             Method::Generated => "generated (analytic)",
+            Method::Dense => "generated, dense LU",
             Method::ForwardDifference => "forward difference",
             Method::CentralDifference => "central difference",
             Method::AutoDiff => "forward-mode AD",
@@ -64,6 +72,7 @@ impl Method {
     pub fn slug(self) -> &'static str {
         match self {
             Method::Generated => "generated",
+            Method::Dense => "dense",
             Method::ForwardDifference => "forward_difference",
             Method::CentralDifference => "central_difference",
             Method::AutoDiff => "autodiff",
@@ -75,8 +84,14 @@ impl Method {
     pub fn description(self) -> &'static str {
         match self {
             Method::Generated => {
+                "the generated solve structure: explicit assignments, Newton on the coupled \
+                 blocks with their analytic Jacobians and static sparse LU, each block's \
+                 velocities and accelerations with the same factors."
+            }
+            Method::Dense => {
                 "Φ and the analytic Φ_q from the generated code, in one pass sharing every sin/cos \
-                 (`phi_and_jacobian`); ν and γ generated."
+                 (`phi_and_jacobian`), solved as one dense block with partial pivoting; ν and γ \
+                 generated."
             }
             Method::ForwardDifference => {
                 "generated Φ; Φ_q column k = (Φ(q + h e_k) − Φ(q)) / h with \
@@ -92,8 +107,9 @@ impl Method {
                  (n passes; no heap use per call); ν and γ generated."
             }
             Method::Interpreted => {
-                "`mechgen_cli::Interpreted`: Φ, Φ_q, ν and γ all evaluated from the IR at run \
-                 time, as a non-generated library would (dynamically sized: heap vectors)."
+                "`mechgen_cli::Interpreted`: the generated code's plan, with every expression \
+                 evaluated from the IR at run time, as a non-generated library would \
+                 (dynamically sized: heap vectors)."
             }
         }
     }
@@ -127,8 +143,7 @@ impl core::fmt::Display for MethodError {
 
 impl std::error::Error for MethodError {}
 
-/// Everything but Φ and Φ_q is the wrapped scene's: names, parameters, guess, ν, γ and the
-/// derivative solves. (One macro so that the three wrappers cannot drift apart.)
+/// Everything but Φ and Φ_q is the wrapped scene's: names, parameters, guess, ν and γ. (One macro so that the three wrappers cannot drift apart.)
 macro_rules! delegate_to_inner {
     () => {
         type Dim = M::Dim;
@@ -189,45 +204,23 @@ macro_rules! delegate_to_inner {
             self.inner.outputs()
         }
 
-        fn derivatives(
-            &self,
-            q: &Vector<M::Dim>,
-            t: f64,
-            factors: &Lu<M::Dim>,
-            qd: &mut Vector<M::Dim>,
-            qdd: &mut Vector<M::Dim>,
-        ) -> Result<(), SolveError> {
-            // The factors are this wrapper's Φ_q; ν and γ are the wrapped scene's.
-            self.inner.derivatives(q, t, factors, qd, qdd)
+        fn nu(&self, q: &Vector<M::Dim>, t: f64, out: &mut Vector<M::Dim>) {
+            self.inner.nu(q, t, out);
+        }
+
+        fn gamma(&self, q: &Vector<M::Dim>, qd: &Vector<M::Dim>, t: f64, out: &mut Vector<M::Dim>) {
+            self.inner.gamma(q, qd, t, out);
         }
     };
 }
 
-/// ν and γ from the wrapped scene, for each wrapper.
+/// The wrapped scene's output level, for each wrapper (ν and γ are delegated above).
 macro_rules! delegate_derivatives {
     ($wrapper:ident) => {
-        impl<M: Velocities> Velocities for $wrapper<M>
-        where
-            DefaultAllocator: Storage<M::Dim>,
+        impl<M: Velocities> Velocities for $wrapper<M> where DefaultAllocator: Storage<M::Dim> {}
+        impl<M: Accelerations> Accelerations for $wrapper<M> where
+            DefaultAllocator: Storage<M::Dim>
         {
-            fn nu(&self, q: &Vector<M::Dim>, t: f64, out: &mut Vector<M::Dim>) {
-                self.inner.nu(q, t, out);
-            }
-        }
-
-        impl<M: Accelerations> Accelerations for $wrapper<M>
-        where
-            DefaultAllocator: Storage<M::Dim>,
-        {
-            fn gamma(
-                &self,
-                q: &Vector<M::Dim>,
-                qd: &Vector<M::Dim>,
-                t: f64,
-                out: &mut Vector<M::Dim>,
-            ) {
-                self.inner.gamma(q, qd, t, out);
-            }
         }
     };
 }
@@ -585,6 +578,8 @@ where
             let inputs = Inputs {
                 q: dual_q.as_slice(),
                 qd: &[],
+                qdd: &[],
+                trig: &[],
                 t,
                 params,
             };
@@ -641,6 +636,8 @@ where
         let inputs = Inputs {
             q: q.as_slice(),
             qd: &[],
+            qdd: &[],
+            trig: &[],
             t,
             params: &self.params,
         };

@@ -23,7 +23,7 @@ use std::time::{Duration, Instant};
 
 use mechgen_cli::Interpreted;
 use mechgen_runtime::nalgebra::{Const, DefaultAllocator};
-use mechgen_runtime::{Accelerations, SolveError, Storage};
+use mechgen_runtime::{Accelerations, Dense, Mechanism, SolveError, Storage, Structured};
 
 use crate::accuracy::RelativeErrors;
 use crate::closed_form::{self, Kinematics};
@@ -377,12 +377,16 @@ struct Case<'a, M, const N: usize> {
     exact: &'a dyn Fn(f64) -> Kinematics<N>,
 }
 
-/// The five methods for one scene, built once.
-struct Methods<M> {
+/// The methods for one scene, built once.
+struct Methods<M: Mechanism>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
     generated: M,
-    forward: ForwardDifference<M>,
-    central: CentralDifference<M>,
-    autodiff: AutoDiff<M>,
+    dense: Dense<M>,
+    forward: Dense<ForwardDifference<M>>,
+    central: Dense<CentralDifference<M>>,
+    autodiff: Dense<AutoDiff<M>>,
     interpreted: Interpreted,
 }
 
@@ -392,14 +396,17 @@ fn run_case<M, const N: usize>(
     counter: &mut Counter<'_, '_>,
 ) -> Result<SceneReport, ReportError>
 where
-    M: Accelerations<Dim = Const<N>> + Clone,
+    M: Structured<Dim = Const<N>> + Accelerations + Clone,
 {
     let scene = mechgen::compile_str(case.source).map_err(|e| ReportError::Scene(e.to_string()))?;
     let methods = Methods {
         generated: case.mechanism.clone(),
-        forward: ForwardDifference::new(case.mechanism.clone()),
-        central: CentralDifference::new(case.mechanism.clone()),
-        autodiff: AutoDiff::new(case.mechanism.clone(), &scene).map_err(ReportError::Method)?,
+        dense: Dense::new(case.mechanism.clone()),
+        forward: Dense::new(ForwardDifference::new(case.mechanism.clone())),
+        central: Dense::new(CentralDifference::new(case.mechanism.clone())),
+        autodiff: Dense::new(
+            AutoDiff::new(case.mechanism.clone(), &scene).map_err(ReportError::Method)?,
+        ),
         interpreted: Interpreted::new(&scene),
     };
     let describe = |error: SolveError| error.describe(&case.mechanism).to_string();
@@ -534,7 +541,7 @@ trait RunSetting<const N: usize> {
 
 impl<M, const N: usize> RunSetting<N> for M
 where
-    M: Accelerations + Clone,
+    M: Structured + Accelerations + Clone,
     DefaultAllocator: Storage<M::Dim>,
 {
     fn accuracy(
@@ -562,12 +569,13 @@ where
 
 impl<M, const N: usize> Methods<M>
 where
-    M: Accelerations<Dim = Const<N>> + Clone,
+    M: Structured<Dim = Const<N>> + Accelerations + Clone,
 {
     /// Calls `f` with the mechanism of `method`.
     fn with<R>(&self, method: Method, f: impl FnOnce(&dyn RunSetting<N>) -> R) -> R {
         match method {
             Method::Generated => f(&self.generated),
+            Method::Dense => f(&self.dense),
             Method::ForwardDifference => f(&self.forward),
             Method::CentralDifference => f(&self.central),
             Method::AutoDiff => f(&self.autodiff),

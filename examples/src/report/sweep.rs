@@ -5,7 +5,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use mechgen_runtime::{
-    Accelerations, Simulation, SolveError, Solver, SolverOptions, Vector, sample_time,
+    Accelerations, Simulation, SolveError, Solver, SolverOptions, Structured, Vector, sample_time,
 };
 
 use crate::accuracy::{ErrorTracker, RelativeErrors};
@@ -182,7 +182,7 @@ pub fn accuracy<M, const N: usize>(
     exact: &dyn Fn(f64) -> Kinematics<N>,
 ) -> Result<(RelativeErrors, f64), SolveError>
 where
-    M: Accelerations + Clone,
+    M: Structured + Accelerations + Clone,
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
 {
     let mut simulation = start(mechanism, setting)?;
@@ -253,7 +253,7 @@ impl Timing {
     /// A [`SolveError`] of the run (the accuracy run would have met it first).
     pub fn run<M>(&mut self, mechanism: &M, setting: Setting, period: f64) -> Result<(), SolveError>
     where
-        M: Accelerations + Clone,
+        M: Structured + Accelerations + Clone,
         mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
     {
         let mut simulation = start(mechanism, setting)?;
@@ -279,7 +279,7 @@ impl Timing {
 /// A simulation of `mechanism` at `setting`, assembled at t = 0.
 fn start<M>(mechanism: &M, setting: Setting) -> Result<Simulation<M>, SolveError>
 where
-    M: Accelerations + Clone,
+    M: Structured + Accelerations + Clone,
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
 {
     let solver = Solver::with_options(mechanism.clone(), setting.options());
@@ -301,7 +301,7 @@ pub fn run_setting<M, const N: usize>(
     plan: &Plan,
 ) -> Result<Measured, SolveError>
 where
-    M: Accelerations + Clone,
+    M: Structured + Accelerations + Clone,
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
 {
     let (errors, iterations) = accuracy(mechanism, setting, period, exact)?;
@@ -325,7 +325,7 @@ where
 /// A [`SolveError`] reaching that state.
 pub fn micro<M>(mechanism: &M, period: f64, plan: &Plan) -> Result<Micro, SolveError>
 where
-    M: Accelerations + Clone,
+    M: Structured + Accelerations + Clone,
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
 {
     let (q, t) = state_at(mechanism, 0.1 * period, plan.reference.options())?;
@@ -339,7 +339,7 @@ fn state_at<M>(
     options: SolverOptions,
 ) -> Result<(Vector<M::Dim>, f64), SolveError>
 where
-    M: Accelerations + Clone,
+    M: Structured + Accelerations + Clone,
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
 {
     let solver = Solver::with_options(mechanism.clone(), options);

@@ -7,9 +7,16 @@
 use mechgen_runtime::math::{cos, sin};
 use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{
-    Accelerations, Lu, Matrix, Mechanism, Outputs, ParameterError, SolveError, Unit, Vector,
-    Velocities, solve_accelerations, solve_velocities,
+    Accelerations, Dense, Matrix, Mechanism, Outputs, ParameterError, Unit, Vector, Velocities,
 };
+
+/// The slider-crank solved by the runtime: only textbook functions, so as one dense block.
+pub type Reference = Dense<SliderCrank>;
+
+/// The reference solve of a slider-crank.
+pub fn reference(scene: SliderCrank) -> Reference {
+    Dense::new(scene)
+}
 
 pub type Q = Vector<Const<9>>;
 
@@ -204,28 +211,11 @@ impl Mechanism for SliderCrank {
         Outputs::Accelerations
     }
 
-    fn derivatives(
-        &self,
-        q: &Vector<Self::Dim>,
-        t: f64,
-        factors: &Lu<Self::Dim>,
-        qd: &mut Vector<Self::Dim>,
-        qdd: &mut Vector<Self::Dim>,
-    ) -> Result<(), SolveError> {
-        solve_velocities(self, q, t, factors, qd)?;
-
-        solve_accelerations(self, q, qd, t, factors, qdd)
-    }
-}
-
-impl Velocities for SliderCrank {
     fn nu(&self, _: &Q, _: f64, out: &mut Q) {
         *out = Q::zeros();
         out[2] = self.parameters[2];
     }
-}
 
-impl Accelerations for SliderCrank {
     fn gamma(&self, q: &Q, qd: &Q, _: f64, out: &mut Q) {
         let [r, l, ..] = self.parameters;
         let (th1, th2, w1, w2) = (q[2], q[5], qd[2], qd[5]);
@@ -236,3 +226,6 @@ impl Accelerations for SliderCrank {
         out[6] = l * sin(th2) * w2 * w2;
     }
 }
+
+impl Velocities for SliderCrank {}
+impl Accelerations for SliderCrank {}

@@ -1,0 +1,584 @@
+//! Function bodies: the DAG reachable from a function's outputs as straight-line Rust, in a
+//! deterministic topological order. A node used more than once, and every elementary function
+//! call, becomes a `let`; a node used once is written inline, parenthesised so the code
+//! evaluates exactly the DAG's order (the interpreter's rounding). Bodies larger than
+//! `max_function_size` are split into helper parts.
+
+use std::cell::RefCell;
+use std::collections::{BTreeSet, HashMap, HashSet};
+
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::{format_ident, quote};
+
+use super::{CodegenOptions, idx};
+use crate::expr::{Arena, Func, Id, Node, Var};
+use crate::interpret::topological_order_with;
+use crate::model::{COORDINATE_SUFFIXES, Model};
+use crate::stats::OpCounts;
+
+/// One generated function body with the names its arguments must take (`q` or `_q` if unused).
+pub(super) struct Function {
+    pub body: TokenStream,
+    /// Argument names for q, q̇, q̈, t (`_q` … when unused).
+    pub args: Args,
+    pub counts: OpCounts,
+}
+
+/// The argument names a body reads its inputs under: `q` or `_q` when it does not read them.
+#[derive(Debug, Clone)]
+pub(super) struct Args {
+    pub q: Ident,
+    pub qd: Ident,
+    pub qdd: Ident,
+    pub trig: Ident,
+    pub t: Ident,
+}
+
+/// No cached nodes: every node is computed.
+pub(super) fn computed() -> HashMap<Id, usize> {
+    HashMap::new()
+}
+
+impl Args {
+    /// `q`, `qd`, `qdd`, `trig`, `t`, each with a leading underscore when not read.
+    pub fn named(q: bool, qd: bool, qdd: bool, trig: bool, t: bool) -> Self {
+        let arg = |used: bool, name: &str| {
+            if used {
+                format_ident!("{}", name)
+            } else {
+                format_ident!("_{}", name)
+            }
+        };
+        Args {
+            q: arg(q, "q"),
+            qd: arg(qd, "qd"),
+            qdd: arg(qdd, "qdd"),
+            trig: arg(trig, "trig"),
+            t: arg(t, "t"),
+        }
+    }
+
+    /// The name of input `q`, `qd`, `qdd`, `trig` or `t`.
+    pub fn get(&self, input: &str) -> &Ident {
+        match input {
+            "qd" => &self.qd,
+            "qdd" => &self.qdd,
+            "trig" => &self.trig,
+            "t" => &self.t,
+            _ => &self.q,
+        }
+    }
+}
+
+impl Function {
+    /// Two doc lines: what the function writes, and what it costs.
+    pub fn doc(&self, what: &str) -> TokenStream {
+        let (what, cost) = (
+            format!(" Writes {what}."),
+            format!(" Operations: {}.", self.counts),
+        );
+        quote! { #[doc = #what] #[doc = ""] #[doc = #cost] }
+    }
+}
+
+pub(super) struct Context<'a> {
+    pub model: &'a Model,
+    /// The branch invariants' values (from the kinematics).
+    pub kinematics_branches: &'a [Id],
+    pub options: &'a CodegenOptions,
+    /// Helper functions of split bodies, emitted in an inherent `impl` block.
+    pub helpers: RefCell<Vec<TokenStream>>,
+}
+
+impl Context<'_> {
+    pub fn arena(&self) -> &Arena {
+        &self.model.arena
+    }
+
+    /// Like [`Context::function`], but a body larger than `max_function_size` operations is
+    /// split: its outputs are grouped in order into parts of bounded size, each emitted as a
+    /// helper method (recomputing the few shared sub-expressions a part needs), and the body
+    /// calls them in turn. `outs` are the output parameters (name, type) passed to each part;
+    /// `inputs` the inputs (`q`, `qd`, `qdd`, `trig`, with their types) the body may read, and
+    /// `cached` the nodes it reads from the trig cache. An input that is also an output
+    /// (explicit assignments read and write `q`) is passed once.
+    pub fn bounded(
+        &self,
+        name: &str,
+        outputs: &[(TokenStream, Id)],
+        clear: TokenStream,
+        outs: &[(&str, TokenStream)],
+        inputs: &[(&str, TokenStream)],
+        cached: &HashMap<Id, usize>,
+    ) -> Function {
+        let groups = self.partition(outputs);
+        if groups.len() <= 1 {
+            return self.function(outputs, clear, cached);
+        }
+        let mut calls = Vec::new();
+        let mut counts = OpCounts::default();
+        let inputs: Vec<&(&str, TokenStream)> = inputs
+            .iter()
+            .filter(|(i, _)| !outs.iter().any(|(o, _)| o == i))
+            .collect();
+        for (k, group) in groups.iter().enumerate() {
+            // Only the outputs this part writes (a Φ part of `phi_and_jacobian` takes no Φ_q).
+            let written: Vec<&(&str, TokenStream)> = outs
+                .iter()
+                .filter(|(o, _)| group.iter().any(|(target, _)| writes_to(target, o)))
+                .collect();
+            let out_names: Vec<Ident> = written
+                .iter()
+                .map(|(o, _)| format_ident!("{}", o))
+                .collect();
+            let out_types: Vec<&TokenStream> = written.iter().map(|(_, ty)| ty).collect();
+            let part = self.function(group, TokenStream::new(), cached);
+            counts = counts + part.counts;
+            let params = inputs.iter().map(|(i, ty)| {
+                let ident = part.args.get(i);
+                quote!(#ident: #ty,)
+            });
+            let arguments = inputs.iter().map(|(i, _)| {
+                let ident = format_ident!("{}", i);
+                quote!(#ident,)
+            });
+            let t = &part.args.t;
+            let part_name = format_ident!("{}_part{}", name, k);
+            let body = part.body;
+            self.helpers.borrow_mut().push(quote! {
+                #[inline(never)]
+                fn #part_name(
+                    &self,
+                    #(#params)*
+                    #t: f64,
+                    #(#out_names: #out_types),*
+                ) {
+                    #body
+                }
+            });
+            calls.push(quote! { self.#part_name(#(#arguments)* t, #(#out_names),*); });
+        }
+        let used =
+            |i: &str| inputs.iter().any(|(n, _)| *n == i) || outs.iter().any(|(o, _)| *o == i);
+        Function {
+            body: quote! { #clear #(#calls)* },
+            args: Args::named(used("q"), used("qd"), used("qdd"), used("trig"), true),
+            counts,
+        }
+    }
+
+    /// `::mechgen_runtime::Vector<Const<N>>` for this scene.
+    pub fn vector_type(&self) -> TokenStream {
+        let n = idx(self.model.dim());
+        quote!(::mechgen_runtime::Vector<::mechgen_runtime::nalgebra::Const<#n>>)
+    }
+
+    /// Non-zero `outputs`, in order, grouped so that each group's DAG nodes plus its output
+    /// stores number at most `max_function_size` (an output larger than that on its own is a
+    /// group by itself).
+    pub fn partition(&self, outputs: &[(TokenStream, Id)]) -> Vec<Vec<(TokenStream, Id)>> {
+        let arena = self.arena();
+        let max = self.options.max_function_size.max(1);
+        // The group whose DAG already holds each node (absent: none yet).
+        let mut group_of: HashMap<Id, usize> = HashMap::new();
+        let mut groups: Vec<Vec<(TokenStream, Id)>> = vec![Vec::new()];
+        let mut size = 0;
+        let mut fresh = Vec::new();
+        for (target, id) in outputs.iter().filter(|(_, id)| !arena.is_zero(*id)) {
+            // Each output is a store as well as the nodes it needs: a part of thousands of
+            // stores of shared constants is still a big function for rustc.
+            new_nodes(arena, *id, &group_of, groups.len(), &mut fresh);
+            if size + fresh.len() + 1 > max && !groups.last().is_some_and(Vec::is_empty) {
+                groups.push(Vec::new());
+                size = 0;
+                new_nodes(arena, *id, &group_of, groups.len(), &mut fresh);
+            }
+            for node in &fresh {
+                group_of.insert(*node, groups.len());
+            }
+            size += fresh.len() + 1;
+            if let Some(group) = groups.last_mut() {
+                group.push((target.clone(), *id));
+            }
+        }
+        groups
+    }
+
+    /// A function body writing `outputs` (non-zero entries; zeros are cleared in one call).
+    ///
+    /// An output with an empty target is written as a bare expression: as the last output, it
+    /// is the body's value (a block's tail). The cost follows the function's DAG, not the
+    /// arena: large scenes emit thousands of small bodies.
+    ///
+    /// The nodes of `cached` are read from the trig cache (`trig[i]`) instead of computed.
+    pub fn function(
+        &self,
+        outputs: &[(TokenStream, Id)],
+        clear: TokenStream,
+        cached: &HashMap<Id, usize>,
+    ) -> Function {
+        let arena = self.arena();
+        let nonzero: Vec<&(TokenStream, Id)> = outputs
+            .iter()
+            .filter(|(_, id)| !arena.is_zero(*id))
+            .collect();
+        let roots: Vec<Id> = nonzero.iter().map(|(_, id)| *id).collect();
+        let order = topological_order_with(arena, &roots, |id| cached.contains_key(&id));
+
+        let mut uses: HashMap<Id, usize> = HashMap::with_capacity(order.len());
+        for &id in &order {
+            for child in arena.children(id) {
+                *uses.entry(child).or_insert(0) += 1;
+            }
+        }
+        for &id in &roots {
+            *uses.entry(id).or_insert(0) += 1;
+        }
+
+        let mut names = Names::default();
+        let mut bound: HashMap<Id, Ident> = HashMap::new();
+        let mut rendered: HashMap<Id, (TokenStream, Prec)> = HashMap::new();
+        let mut lets = Vec::new();
+        // Coordinate loads go first, in q order, then the cached trig: the reader sees the
+        // inputs, then the work.
+        let mut loads: Vec<(Var, TokenStream)> = Vec::new();
+        let mut trig_loads: Vec<(usize, TokenStream)> = Vec::new();
+        let mut funcs = BTreeSet::new();
+        let (mut reads_q, mut reads_qd, mut reads_qdd, mut reads_t) = (false, false, false, false);
+        let counts = if self.options.naive {
+            OpCounts::of_tree(arena, &roots)
+        } else {
+            OpCounts::of(arena, &order)
+        };
+
+        // sin(x) and cos(x) of one argument come from one `sincos(x)`: one argument reduction.
+        let in_order: HashSet<Id> = order.iter().copied().collect();
+        let partner = |id: Id| {
+            match arena.node(id) {
+                Node::Call(Func::Sin, a) => arena.find(Node::Call(Func::Cos, a)),
+                Node::Call(Func::Cos, a) => arena.find(Node::Call(Func::Sin, a)),
+                _ => None,
+            }
+            .filter(|p| in_order.contains(p) && !cached.contains_key(p) && !self.options.naive)
+        };
+
+        for &id in &order {
+            if bound.contains_key(&id) {
+                // The second of a sin/cos pair, bound with the first.
+                continue;
+            }
+            if let Some(&i) = cached.get(&id) {
+                let ident = names.fresh(&self.suggest(id));
+                let i_lit = idx(i);
+                trig_loads.push((i, quote! { let #ident = trig[#i_lit]; }));
+                bound.insert(id, ident);
+                continue;
+            }
+            let node = arena.node(id);
+            if let (Some(other), Node::Call(f, a)) = (partner(id), node) {
+                let (sin, cos) = if f == Func::Sin {
+                    (id, other)
+                } else {
+                    (other, id)
+                };
+                let argument = match bound.get(&a) {
+                    Some(ident) => quote!(#ident),
+                    None => rendered.get(&a).map_or(quote!(0.0), |(t, _)| t.clone()),
+                };
+                let (s, c) = (
+                    names.fresh(&self.suggest(sin)),
+                    names.fresh(&self.suggest(cos)),
+                );
+                funcs.insert("sincos");
+                lets.push(quote! { let (#s, #c) = sincos(#argument); });
+                bound.insert(sin, s);
+                bound.insert(cos, c);
+                continue;
+            }
+            let operand = |x: Id| -> (TokenStream, Prec) {
+                match bound.get(&x) {
+                    Some(ident) => (quote!(#ident), Prec::Atom),
+                    None => rendered
+                        .get(&x)
+                        .cloned()
+                        .unwrap_or_else(|| (quote!(0.0), Prec::Atom)),
+                }
+            };
+            let load = |vector: &str, k: u32| {
+                let (vector, k) = (format_ident!("{}", vector), idx(k as usize));
+                (quote!(#vector[#k]), Prec::Atom)
+            };
+            let (tokens, prec) = match node {
+                Node::Const(bits) => {
+                    let value = f64::from_bits(bits);
+                    // Negative literals are written `-c` and parenthesised like a sum in operands.
+                    let prec = if value < 0.0 { Prec::Sum } else { Prec::Atom };
+                    (f64_literal(value), prec)
+                }
+                Node::Param(i) => {
+                    let name = &self.model.params[i as usize].name;
+                    (quote!(self.#name), Prec::Atom)
+                }
+                Node::Var(Var::T) => {
+                    reads_t = true;
+                    (quote!(t), Prec::Atom)
+                }
+                Node::Var(Var::Q(k)) => {
+                    reads_q = true;
+                    load("q", k)
+                }
+                Node::Var(Var::Qd(k)) => {
+                    reads_qd = true;
+                    load("qd", k)
+                }
+                Node::Var(Var::Qdd(k)) => {
+                    reads_qdd = true;
+                    load("qdd", k)
+                }
+                Node::Neg(a) => {
+                    let a = operand(a).wrap(Prec::Unary);
+                    (quote!(-#a), Prec::Unary)
+                }
+                Node::Add(a, b) => binary(operand(a), quote!(+), operand(b), Prec::Sum),
+                Node::Sub(a, b) => binary(operand(a), quote!(-), operand(b), Prec::Sum),
+                Node::Mul(a, b) => binary(operand(a), quote!(*), operand(b), Prec::Product),
+                Node::Div(a, b) => binary(operand(a), quote!(/), operand(b), Prec::Product),
+                Node::Powi(a, n) => {
+                    funcs.insert("powi");
+                    let a = operand(a).0;
+                    (quote!(powi(#a, #n)), Prec::Atom)
+                }
+                Node::Call(f, a) => {
+                    funcs.insert(f.name());
+                    let f_ident = format_ident!("{}", f.name());
+                    let a = operand(a).0;
+                    (quote!(#f_ident(#a)), Prec::Atom)
+                }
+            };
+            let is_leaf = matches!(node, Node::Const(_) | Node::Param(_) | Node::Var(Var::T));
+            // Coordinates are loaded once; the naive baseline shares nothing else.
+            let shared = matches!(node, Node::Call(..)) || uses.get(&id).copied().unwrap_or(0) > 1;
+            let bind =
+                !is_leaf && (matches!(node, Node::Var(_)) || (shared && !self.options.naive));
+            if bind {
+                let ident = names.fresh(&self.suggest(id));
+                let statement = quote! { let #ident = #tokens; };
+                match node {
+                    Node::Var(v) => loads.push((v, statement)),
+                    _ => lets.push(statement),
+                }
+                bound.insert(id, ident);
+            } else {
+                rendered.insert(id, (tokens, prec));
+            }
+        }
+
+        let writes = nonzero.iter().map(|(target, id)| {
+            let value = match bound.get(id) {
+                Some(ident) => quote!(#ident),
+                None => rendered
+                    .get(id)
+                    .cloned()
+                    .map_or_else(|| quote!(0.0), |(t, _)| t),
+            };
+            if target.is_empty() {
+                value
+            } else {
+                quote! { #target = #value; }
+            }
+        });
+        let imports = if funcs.is_empty() {
+            TokenStream::new()
+        } else {
+            let funcs = funcs.iter().map(|f| format_ident!("{}", f));
+            quote! { use ::mechgen_runtime::math::{#(#funcs),*}; }
+        };
+        loads.sort_by_key(|(v, _)| *v);
+        trig_loads.sort_by_key(|(i, _)| *i);
+        let reads_trig = !trig_loads.is_empty();
+        let loads = loads
+            .into_iter()
+            .map(|(_, statement)| statement)
+            .chain(trig_loads.into_iter().map(|(_, statement)| statement));
+        Function {
+            body: quote! { #imports #(#loads)* #(#lets)* #clear #(#writes)* },
+            args: Args::named(reads_q, reads_qd, reads_qdd, reads_trig, reads_t),
+            counts,
+        }
+    }
+
+    /// A readable name for a bound node: `rod_theta`, `sin_rod_theta`, `piston_x_dot`, or `e`.
+    fn suggest(&self, id: Id) -> String {
+        let arena = self.arena();
+        let coordinate = |k: u32| {
+            let k = k as usize;
+            let body = &self.model.bodies[k / 3].name;
+            format!("{body}_{}", COORDINATE_SUFFIXES[k % 3])
+        };
+        match arena.node(id) {
+            Node::Var(Var::Q(k)) => coordinate(k),
+            Node::Var(Var::Qd(k)) => format!("{}_dot", coordinate(k)),
+            Node::Var(Var::Qdd(k)) => format!("{}_ddot", coordinate(k)),
+            Node::Call(f, a) => match arena.node(a) {
+                Node::Var(Var::Q(k)) => format!("{}_{}", f.name(), coordinate(k)),
+                _ => f.name().to_owned() + "_",
+            },
+            _ => "e".to_owned(),
+        }
+    }
+}
+
+/// True if an output target (`out[3]`, `jacobian[(1, 2)]`) writes to the parameter `name`.
+pub(super) fn writes_to(target: &TokenStream, name: &str) -> bool {
+    matches!(target.clone().into_iter().next(), Some(proc_macro2::TokenTree::Ident(i)) if i == name)
+}
+
+/// The nodes reachable from `root` not yet in group `group`, into `fresh` (iterative: scenes can
+/// be deep).
+fn new_nodes(
+    arena: &Arena,
+    root: Id,
+    group_of: &HashMap<Id, usize>,
+    group: usize,
+    fresh: &mut Vec<Id>,
+) {
+    fresh.clear();
+    let mut seen = HashSet::new();
+    let mut stack = vec![root];
+    while let Some(id) = stack.pop() {
+        if group_of.get(&id) == Some(&group) || !seen.insert(id) {
+            continue;
+        }
+        fresh.push(id);
+        stack.extend(arena.children(id));
+    }
+}
+
+/// Unique, hygienic local names (numbered where a suggestion repeats).
+#[derive(Default)]
+struct Names {
+    taken: HashSet<String>,
+    counter: usize,
+}
+
+impl Names {
+    fn fresh(&mut self, suggestion: &str) -> Ident {
+        let numbered = suggestion.ends_with('_') || suggestion == "e";
+        let mut candidate = suggestion.trim_end_matches('_').to_owned();
+        if numbered || self.taken.contains(&candidate) || Func::from_name(&candidate).is_some() {
+            loop {
+                let next = format!("{}{}", candidate.trim_end_matches('_'), self.counter);
+                self.counter += 1;
+                if !self.taken.contains(&next) {
+                    candidate = next;
+                    break;
+                }
+            }
+        }
+        self.taken.insert(candidate.clone());
+        Ident::new(&candidate, Span::mixed_site())
+    }
+}
+
+/// Binding strength, for parenthesising inlined operands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Prec {
+    Sum,
+    Product,
+    Unary,
+    Atom,
+}
+
+trait Wrap {
+    fn wrap(self, min: Prec) -> TokenStream;
+}
+
+impl Wrap for (TokenStream, Prec) {
+    fn wrap(self, min: Prec) -> TokenStream {
+        let (tokens, prec) = self;
+        if prec < min {
+            quote!((#tokens))
+        } else {
+            tokens
+        }
+    }
+}
+
+/// `a op b`, left-associative: the right operand is parenthesised at equal precedence so the
+/// generated code evaluates in exactly the DAG's order (same rounding as the interpreter).
+fn binary(
+    a: (TokenStream, Prec),
+    op: TokenStream,
+    b: (TokenStream, Prec),
+    prec: Prec,
+) -> (TokenStream, Prec) {
+    let a = a.wrap(prec);
+    let b = if b.1 <= prec {
+        let tokens = b.0;
+        quote!((#tokens))
+    } else {
+        b.0
+    };
+    (quote!(#a #op #b), prec)
+}
+
+/// An `f64` literal that round-trips exactly (`-c` for negative values; operands that need it
+/// are parenthesised by the caller).
+pub fn f64_literal(value: f64) -> TokenStream {
+    if !value.is_finite() {
+        // Unreachable for checked models (literals are validated, folding keeps finiteness);
+        // kept total so emission can never panic.
+        return if value.is_nan() {
+            quote!(f64::NAN)
+        } else if value > 0.0 {
+            quote!(f64::INFINITY)
+        } else {
+            quote!(f64::NEG_INFINITY)
+        };
+    }
+    let magnitude = value.abs();
+    // `{:?}` is the shortest representation that round-trips, with an exponent for extremes.
+    let text = format!("{magnitude:?}");
+    let literal: Literal = text
+        .parse()
+        .unwrap_or_else(|_| Literal::f64_unsuffixed(magnitude));
+    if value.is_sign_negative() {
+        quote!(-#literal)
+    } else {
+        quote!(#literal)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn literals_round_trip() {
+        for v in [
+            0.0,
+            1.0,
+            156.8,
+            1e-6,
+            1e-300,
+            6.02e23,
+            0.1 + 0.2,
+            f64::MAX,
+            -2.5,
+        ] {
+            let text = f64_literal(v).to_string().replace(['(', ')', ' '], "");
+            assert_eq!(text.parse::<f64>().unwrap(), v, "{text}");
+        }
+        assert_eq!(f64_literal(-2.5).to_string(), "- 2.5");
+        assert_eq!(f64_literal(3.0).to_string(), "3.0");
+    }
+
+    #[test]
+    fn names_are_unique_and_numbered() {
+        let mut names = Names::default();
+        assert_eq!(names.fresh("rod_theta").to_string(), "rod_theta");
+        assert_eq!(names.fresh("rod_theta").to_string(), "rod_theta0");
+        assert_eq!(names.fresh("e").to_string(), "e1");
+        assert_eq!(names.fresh("sin_").to_string(), "sin2");
+    }
+}

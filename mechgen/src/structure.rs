@@ -1,0 +1,750 @@
+//! The solve structure: which equations decide which coordinates, and in what order — the plan
+//! that both the emitter (as specialised code) and the interpreter (as data) follow.
+//!
+//! 1. **Fixed coordinates.** An equation affine in a single unknown coordinate with a constant
+//!    coefficient, whose value does not depend on q or t (a ground pose, a pin on a fixed point
+//!    at a body's reference point, a prismatic joint's angle to a fixed body), fixes that
+//!    coordinate. Its value is substituted into every other equation, which may reveal more;
+//!    this repeats until nothing changes. Ground bodies and what they pin cost nothing after.
+//! 2. **Block-triangular order** of the rest: a maximum matching of equations to coordinates
+//!    (`graph`), then the strongly connected components of the matched graph (Tarjan), in
+//!    dependency order. Each component's equations read only its own and earlier coordinates.
+//! 3. **Explicit assignments.** A one-equation component affine in its coordinate with a
+//!    constant coefficient `a` (a driver `θ = f(t)`, a pin on a point already placed) is
+//!    assigned in closed form: `q_c = −g/a`, `g` the equation with `q_c = 0`. Its velocity and
+//!    acceleration follow from the same row of Φ_q q̇ = ν and Φ_q q̈ = γ.
+//! 4. **Newton blocks** for every other component, each with a static LU (`factor`) whose pivot
+//!    order is chosen here at the scene's initial guess, and the right-hand sides of its
+//!    velocity and acceleration solves: `ν_b − Φ_q[b, earlier] q̇_earlier`, and the same with γ
+//!    and q̈.
+//!
+//! Rates that turn out constant (a ground body's zero velocity, a driver's ω) are substituted
+//! forward as well, so the generated code does no work for them.
+
+use std::collections::HashMap;
+
+use crate::diff::Differentiator;
+use crate::expr::{Arena, Func, Id, Node, Var};
+use crate::factor::{self, Factorization};
+use crate::graph;
+use crate::interpret::{Inputs, Tape};
+use crate::kinematics::Kinematics;
+use crate::model::{Model, Outputs};
+
+/// Static factorisations with more updates than this are not emitted as straight-line code
+/// (rustc's time grows quickly with a function's size); such a block is factored with partial
+/// pivoting at run time.
+pub const MAX_STATIC_UPDATES: usize = 20_000;
+
+/// The stages of a scene's solve, in order.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// Stages in solve order; every coordinate belongs to exactly one.
+    pub stages: Vec<Stage>,
+    /// For each stage, the earlier stages whose coordinates it reads, ascending (a singular
+    /// stage leaves the coordinates of every stage downstream of it undetermined too).
+    pub reads: Vec<Vec<usize>>,
+    /// Sines and cosines computed once per solve, when their angle is solved.
+    pub trig: TrigCache,
+}
+
+/// The solve's trig cache: the sine and cosine of each angle a later kernel needs, computed once
+/// (one `sincos`) right after the stage that determines the angle, and read from the cache by
+/// every kernel that runs after that (later stages, and the stage's own rates). Without it, a
+/// seed step computed sin and cos of the rod angle in six kernels.
+#[derive(Debug, Clone, Default)]
+pub struct TrigCache {
+    /// Slot `m` holds the sine (at `2m`) and cosine (at `2m + 1`) of coordinate `angles[m]`.
+    pub angles: Vec<usize>,
+    /// The nodes `sin q_k` and `cos q_k` of each slot.
+    pub nodes: Vec<(Id, Id)>,
+    /// The stage that fills each slot.
+    pub filled_by: Vec<usize>,
+}
+
+/// When a kernel of a stage runs: before the stage's positions are known (explicit positions,
+/// a block's Newton iteration) or after (its rates, its trig fill).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// Computing the stage's positions.
+    Positions,
+    /// After the stage's positions are known.
+    After,
+}
+
+impl TrigCache {
+    /// Length of the cache buffer.
+    pub fn len(&self) -> usize {
+        2 * self.angles.len()
+    }
+
+    /// True without cached angles.
+    pub fn is_empty(&self) -> bool {
+        self.angles.is_empty()
+    }
+
+    /// The slots stage `stage` fills.
+    pub fn fills(&self, stage: usize) -> impl Iterator<Item = usize> + '_ {
+        (0..self.angles.len()).filter(move |&m| self.filled_by[m] == stage)
+    }
+
+    /// The cached nodes among those reachable from `roots` that a kernel of `stage` running in
+    /// `phase` reads from the cache, with their position in the buffer.
+    pub fn reads(
+        &self,
+        arena: &Arena,
+        roots: &[Id],
+        stage: usize,
+        phase: Phase,
+    ) -> HashMap<Id, usize> {
+        let ready = |m: usize| match phase {
+            Phase::Positions => self.filled_by[m] < stage,
+            Phase::After => self.filled_by[m] <= stage,
+        };
+        let slot: HashMap<Id, usize> = self
+            .nodes
+            .iter()
+            .enumerate()
+            .filter(|&(m, _)| ready(m))
+            .flat_map(|(m, &(sin, cos))| [(sin, 2 * m), (cos, 2 * m + 1)])
+            .collect();
+        crate::interpret::topological_order(arena, roots)
+            .into_iter()
+            .filter_map(|id| slot.get(&id).map(|&i| (id, i)))
+            .collect()
+    }
+}
+
+/// One stage of the solve.
+#[derive(Debug, Clone)]
+pub enum Stage {
+    /// Coordinates assigned in closed form, in order.
+    Explicit(Vec<Assignment>),
+    /// Equations solved together by Newton's method.
+    Block(Block),
+}
+
+/// A coordinate assigned in closed form by one equation.
+#[derive(Debug, Clone)]
+pub struct Assignment {
+    /// The equation (global index).
+    pub equation: usize,
+    /// The coordinate it assigns (global index).
+    pub coordinate: usize,
+    /// q_c in earlier coordinates, t and parameters.
+    pub position: Id,
+    /// q̇_c in earlier coordinates and velocities, if the scene computes velocities.
+    pub velocity: Option<Id>,
+    /// q̈_c (also reading earlier accelerations, `Var::Qdd`), if it computes accelerations.
+    pub acceleration: Option<Id>,
+}
+
+/// Equations solved together, rows and columns in pivot order.
+#[derive(Debug, Clone)]
+pub struct Block {
+    /// Global equation indices, in the block's row (pivot) order.
+    pub equations: Vec<usize>,
+    /// Global coordinate indices, in the block's column (pivot) order.
+    pub coordinates: Vec<usize>,
+    /// Each equation's value (fixed coordinates substituted), in row order.
+    pub residuals: Vec<Id>,
+    /// `(row, column, ∂Φ/∂q)` of each Jacobian entry, in slot order: column-major.
+    pub entries: Vec<(usize, usize, Id)>,
+    /// The static LU, unless too large to emit.
+    pub factorization: Option<Factorization>,
+    /// `ν_b − Φ_q[b, earlier] q̇_earlier`, in row order, if the scene computes velocities.
+    pub velocity_rhs: Option<Vec<Id>>,
+    /// `γ_b − Φ_q[b, earlier] q̈_earlier`, in row order, if it computes accelerations.
+    pub acceleration_rhs: Option<Vec<Id>>,
+}
+
+impl Block {
+    /// Length of the block's value array: entries, then fill-in.
+    pub fn slots(&self) -> usize {
+        self.factorization
+            .as_ref()
+            .map_or(self.entries.len(), |f| f.slots)
+    }
+}
+
+impl Plan {
+    /// Size of the largest block (at least 1: sizes the runtime's workspace).
+    pub fn largest_block(&self) -> usize {
+        self.blocks()
+            .map(|b| b.equations.len())
+            .max()
+            .unwrap_or(0)
+            .max(1)
+    }
+
+    /// Most value slots of a block (at least 1).
+    pub fn largest_slots(&self) -> usize {
+        self.blocks().map(Block::slots).max().unwrap_or(0).max(1)
+    }
+
+    /// The Newton blocks, in order.
+    pub fn blocks(&self) -> impl Iterator<Item = &Block> {
+        self.stages.iter().filter_map(|s| match s {
+            Stage::Block(b) => Some(b),
+            Stage::Explicit(_) => None,
+        })
+    }
+
+    /// The explicit assignments, in order.
+    pub fn assignments(&self) -> impl Iterator<Item = &Assignment> {
+        self.stages.iter().flat_map(|s| match s {
+            Stage::Explicit(a) => a.as_slice(),
+            Stage::Block(_) => &[],
+        })
+    }
+}
+
+/// Derives the plan of a checked scene, adding its expressions to the model's arena. The naive
+/// baseline (an unsimplified arena, which cannot recognise constants) gets [`single_block`].
+pub fn plan(model: &mut Model, kin: &Kinematics) -> Plan {
+    if !model.arena.simplifies() {
+        return single_block(kin);
+    }
+    let outputs = model.outputs;
+    let params: Vec<f64> = model.params.iter().map(|p| p.default).collect();
+    let mut cx = Planner {
+        arena: &mut model.arena,
+        kin,
+        d: Differentiator::new(),
+        rows: jacobian_rows(kin, kin.phi.len()),
+        map: HashMap::new(),
+        local: HashMap::new(),
+        outputs,
+        params,
+        sample: Vec::new(),
+    };
+    let n = kin.phi.len();
+    cx.sample = cx.evaluate(&kin.guess, &vec![0.0; n]);
+    let mut phi = kin.phi.clone();
+    let mut known = vec![false; n];
+    let mut done = vec![false; n];
+    let mut stages = Vec::new();
+    let fixed = cx.fix(&mut phi, &mut known, &mut done);
+    if !fixed.is_empty() {
+        stages.push(Stage::Explicit(fixed));
+    }
+    // The fixed coordinates stay a stage of their own; later consecutive assignments merge
+    // into one explicit stage, each reading the earlier ones of its stage by substitution.
+    let first_free = stages.len();
+    for component in cx.components(&phi, &known, &done) {
+        let open = stages.len() > first_free && matches!(stages.last(), Some(Stage::Explicit(_)));
+        if !open {
+            cx.local.clear();
+        }
+        match (cx.stage(&phi, component), stages.last_mut()) {
+            (Stage::Explicit(more), Some(Stage::Explicit(previous))) if open => {
+                previous.extend(more);
+            }
+            (stage, _) => stages.push(stage),
+        }
+    }
+    let reads = reads(cx.arena, &stages, n);
+    let trig = trig_cache(cx.arena, &stages, n);
+    Plan {
+        stages,
+        reads,
+        trig,
+    }
+}
+
+/// The kernels of a stage, by the phase they run in.
+fn kernel_roots(stage: &Stage) -> [(Phase, Vec<Id>); 2] {
+    match stage {
+        Stage::Explicit(assignments) => [
+            (
+                Phase::Positions,
+                assignments.iter().map(|a| a.position).collect(),
+            ),
+            (
+                Phase::After,
+                assignments
+                    .iter()
+                    .flat_map(|a| a.velocity.into_iter().chain(a.acceleration))
+                    .collect(),
+            ),
+        ],
+        Stage::Block(block) => [
+            (
+                Phase::Positions,
+                block
+                    .residuals
+                    .iter()
+                    .copied()
+                    .chain(block.entries.iter().map(|e| e.2))
+                    .collect(),
+            ),
+            (
+                Phase::After,
+                block
+                    .velocity_rhs
+                    .iter()
+                    .chain(&block.acceleration_rhs)
+                    .flatten()
+                    .copied()
+                    .collect(),
+            ),
+        ],
+    }
+}
+
+/// The angles worth caching: those whose sine or cosine a kernel reads after the angle's stage
+/// is solved.
+fn trig_cache(arena: &mut Arena, stages: &[Stage], n: usize) -> TrigCache {
+    let mut stage_of = vec![0; n];
+    for (s, stage) in stages.iter().enumerate() {
+        for c in stage_coordinates(stage) {
+            stage_of[c] = s;
+        }
+    }
+    let mut wanted = vec![false; n];
+    for (s, stage) in stages.iter().enumerate() {
+        for (phase, roots) in kernel_roots(stage) {
+            for id in crate::interpret::topological_order(arena, &roots) {
+                if let Node::Call(Func::Sin | Func::Cos, a) = arena.node(id)
+                    && let Node::Var(Var::Q(k)) = arena.node(a)
+                {
+                    let k = k as usize;
+                    let ready = match phase {
+                        Phase::Positions => stage_of[k] < s,
+                        Phase::After => stage_of[k] <= s,
+                    };
+                    wanted[k] |= ready;
+                }
+            }
+        }
+    }
+    let angles: Vec<usize> = (0..n).filter(|&k| wanted[k]).collect();
+    let nodes = angles
+        .iter()
+        .map(|&k| {
+            let q = arena.var(Var::Q(index(k)));
+            (arena.sin(q), arena.cos(q))
+        })
+        .collect();
+    let filled_by = angles.iter().map(|&k| stage_of[k]).collect();
+    TrigCache {
+        angles,
+        nodes,
+        filled_by,
+    }
+}
+
+/// The earlier stages each stage reads (through its positions or residuals: rates read the
+/// same stages).
+fn reads(arena: &Arena, stages: &[Stage], n: usize) -> Vec<Vec<usize>> {
+    let mut stage_of = vec![0; n];
+    for (s, stage) in stages.iter().enumerate() {
+        for c in stage_coordinates(stage) {
+            stage_of[c] = s;
+        }
+    }
+    stages
+        .iter()
+        .enumerate()
+        .map(|(s, stage)| {
+            let expressions: Vec<Id> = match stage {
+                Stage::Explicit(assignments) => assignments.iter().map(|a| a.position).collect(),
+                Stage::Block(block) => block.residuals.clone(),
+            };
+            let mut read: Vec<usize> = expressions
+                .iter()
+                .flat_map(|&e| arena.variables(e))
+                .filter_map(|v| match v {
+                    Var::Q(k) => Some(stage_of[k as usize]),
+                    _ => None,
+                })
+                .filter(|&r| r != s)
+                .collect();
+            read.sort_unstable();
+            read.dedup();
+            read
+        })
+        .collect()
+}
+
+/// The coordinates a stage determines.
+pub fn stage_coordinates(stage: &Stage) -> Vec<usize> {
+    match stage {
+        Stage::Explicit(assignments) => assignments.iter().map(|a| a.coordinate).collect(),
+        Stage::Block(block) => block.coordinates.clone(),
+    }
+}
+
+/// The plan without structure: every equation in one block, factored with partial pivoting at
+/// run time (what the runtime did before scenes carried their structure).
+pub fn single_block(kin: &Kinematics) -> Plan {
+    let n = kin.phi.len();
+    let mut entries: Vec<(usize, usize, Id)> = kin
+        .jacobian
+        .iter()
+        .map(|e| (e.row, e.col, e.value))
+        .collect();
+    entries.sort_by_key(|&(r, c, _)| (c, r));
+    Plan {
+        stages: vec![Stage::Block(Block {
+            equations: (0..n).collect(),
+            coordinates: (0..n).collect(),
+            residuals: kin.phi.clone(),
+            entries,
+            factorization: None,
+            velocity_rhs: kin.nu.clone(),
+            acceleration_rhs: kin.gamma.clone(),
+        })],
+        reads: vec![Vec::new()],
+        trig: TrigCache::default(),
+    }
+}
+
+/// Each row of Φ_q as (coordinate, ∂Φ/∂q) pairs.
+fn jacobian_rows(kin: &Kinematics, n: usize) -> Vec<Vec<(usize, Id)>> {
+    let mut rows = vec![Vec::new(); n];
+    for e in &kin.jacobian {
+        rows[e.row].push((e.col, e.value));
+    }
+    rows
+}
+
+/// One structured component of the remaining system: equations and their matched coordinates.
+struct Component {
+    equations: Vec<usize>,
+    coordinates: Vec<usize>,
+}
+
+struct Planner<'a> {
+    arena: &'a mut Arena,
+    kin: &'a Kinematics,
+    d: Differentiator,
+    /// Rows of the (unsubstituted) Jacobian.
+    rows: Vec<Vec<(usize, Id)>>,
+    /// Substitutions applied to every expression of the plan: fixed coordinates by their
+    /// values, and constant rates (`Var::Qd`, `Var::Qdd`) by theirs.
+    map: HashMap<Var, Id>,
+    /// The explicit stage being built: its coordinates' positions, velocities and accelerations
+    /// by variable, substituted into the later assignments of the stage (which its kernels
+    /// evaluate before writing anything back).
+    local: HashMap<Var, Id>,
+    outputs: Outputs,
+    params: Vec<f64>,
+    /// A representative configuration for choosing pivots: the initial guess, with explicit
+    /// coordinates assigned at t = 0.
+    sample: Vec<f64>,
+}
+
+impl Planner<'_> {
+    /// Step 1: fixed coordinates, until substituting them reveals no more.
+    fn fix(&mut self, phi: &mut [Id], known: &mut [bool], done: &mut [bool]) -> Vec<Assignment> {
+        let mut fixed = Vec::new();
+        loop {
+            let start = fixed.len();
+            for i in 0..phi.len() {
+                if done[i] {
+                    continue;
+                }
+                let Some(c) = self.single_unknown(phi[i], known) else {
+                    continue;
+                };
+                let Some((value, _)) = self.explicit_value(phi[i], c) else {
+                    continue;
+                };
+                if !self.arena.is_invariant(value) {
+                    continue;
+                }
+                known[c] = true;
+                done[i] = true;
+                self.map.insert(Var::Q(index(c)), value);
+                let zero = self.arena.zero();
+                self.map.insert(Var::Qd(index(c)), zero);
+                self.map.insert(Var::Qdd(index(c)), zero);
+                let rates = self.outputs >= Outputs::Velocities;
+                let accelerations = self.outputs >= Outputs::Accelerations;
+                fixed.push(Assignment {
+                    equation: i,
+                    coordinate: c,
+                    position: value,
+                    velocity: rates.then_some(zero),
+                    acceleration: accelerations.then_some(zero),
+                });
+                self.sample[c] = self.evaluate(&[value], &self.sample.clone())[0];
+            }
+            if fixed.len() == start {
+                break;
+            }
+            let mut memo = HashMap::new();
+            for (i, e) in phi.iter_mut().enumerate() {
+                if !done[i] {
+                    *e = self.arena.substitute(*e, &self.map, &mut memo);
+                }
+            }
+        }
+        fixed.sort_by_key(|a| a.coordinate);
+        fixed
+    }
+
+    /// The only coordinate of `e` not yet known, if there is exactly one.
+    fn single_unknown(&self, e: Id, known: &[bool]) -> Option<usize> {
+        let mut unknown = self.unknowns(e, known);
+        (unknown.len() == 1).then(|| unknown.remove(0))
+    }
+
+    fn unknowns(&self, e: Id, known: &[bool]) -> Vec<usize> {
+        self.arena
+            .variables(e)
+            .into_iter()
+            .filter_map(|v| match v {
+                Var::Q(k) if !known[k as usize] => Some(k as usize),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// `(q_c = −g/a, a)` if `e = a·q_c + g` with a constant non-zero `a`.
+    fn explicit_value(&mut self, e: Id, c: usize) -> Option<(Id, f64)> {
+        let slope = self.d.diff(self.arena, e, Var::Q(index(c)));
+        let a = self.arena.as_const(slope)?;
+        if a == 0.0 || !a.is_finite() {
+            return None;
+        }
+        let zero = HashMap::from([(Var::Q(index(c)), self.arena.zero())]);
+        let g = self.arena.substitute(e, &zero, &mut HashMap::new());
+        Some((self.divide(g, -a), a))
+    }
+
+    /// `e / a` for a constant `a`, exactly `e` or `−e` for ±1.
+    fn divide(&mut self, e: Id, a: f64) -> Id {
+        if a == 1.0 {
+            e
+        } else if a == -1.0 {
+            self.arena.neg(e)
+        } else {
+            let a = self.arena.constant(a);
+            self.arena.div(e, a)
+        }
+    }
+
+    /// Step 2: the remaining system's components in dependency order (one component of
+    /// everything if its structure is singular: the run time's diagnosis then names the
+    /// equations).
+    fn components(&self, phi: &[Id], known: &[bool], done: &[bool]) -> Vec<Component> {
+        let equations: Vec<usize> = (0..phi.len()).filter(|&i| !done[i]).collect();
+        let coordinates: Vec<usize> = (0..known.len()).filter(|&c| !known[c]).collect();
+        let mut local = vec![usize::MAX; known.len()];
+        for (l, &c) in coordinates.iter().enumerate() {
+            local[c] = l;
+        }
+        let pattern: Vec<Vec<usize>> = equations
+            .iter()
+            .map(|&i| {
+                self.unknowns(phi[i], known)
+                    .into_iter()
+                    .map(|c| local[c])
+                    .collect()
+            })
+            .collect();
+        let matching = graph::maximum_matching(&pattern, coordinates.len());
+        if !matching.is_perfect() {
+            return vec![Component {
+                equations,
+                coordinates,
+            }];
+        }
+        // Equation r depends on the equation matched to each other coordinate it reads.
+        let successors: Vec<Vec<usize>> = pattern
+            .iter()
+            .enumerate()
+            .map(|(r, cols)| {
+                cols.iter()
+                    .filter(|&&c| c != matching.row[r])
+                    .map(|&c| matching.column[c])
+                    .collect()
+            })
+            .collect();
+        graph::strongly_connected_components(equations.len(), |r| &successors[r])
+            .into_iter()
+            .map(|rows| Component {
+                coordinates: rows.iter().map(|&r| coordinates[matching.row[r]]).collect(),
+                equations: rows.iter().map(|&r| equations[r]).collect(),
+            })
+            .collect()
+    }
+
+    /// Steps 3 and 4: a component as an explicit assignment or a Newton block.
+    fn stage(&mut self, phi: &[Id], component: Component) -> Stage {
+        if let ([i], [c]) = (&component.equations[..], &component.coordinates[..])
+            && let Some((position, a)) = self.explicit_value(phi[*i], *c)
+        {
+            return Stage::Explicit(vec![self.assignment(*i, *c, position, a)]);
+        }
+        Stage::Block(self.block(phi, component))
+    }
+
+    /// The assignment of `q_c` by equation `i` (coefficient `a` of `q_c` in it), with its rates.
+    fn assignment(&mut self, i: usize, c: usize, position: Id, a: f64) -> Assignment {
+        let known = self.sample.clone();
+        self.sample[c] = self.evaluate(&[position], &known)[0];
+        let position = self.within_stage(Var::Q(index(c)), position);
+        let velocity = (self.outputs >= Outputs::Velocities).then(|| {
+            let nu = self.kin.nu.as_ref().map_or(self.arena.zero(), |nu| nu[i]);
+            let rhs = self.rate_rhs(nu, i, &[c], Var::Qd);
+            let value = self.divide(rhs, a);
+            let value = self.forward(Var::Qd(index(c)), value);
+            self.within_stage(Var::Qd(index(c)), value)
+        });
+        let acceleration = (self.outputs >= Outputs::Accelerations).then(|| {
+            let gamma = self.kin.gamma.as_ref().map_or(self.arena.zero(), |g| g[i]);
+            let rhs = self.rate_rhs(gamma, i, &[c], Var::Qdd);
+            let value = self.divide(rhs, a);
+            let value = self.forward(Var::Qdd(index(c)), value);
+            self.within_stage(Var::Qdd(index(c)), value)
+        });
+        Assignment {
+            equation: i,
+            coordinate: c,
+            position,
+            velocity,
+            acceleration,
+        }
+    }
+
+    /// `value` with the stage's earlier assignments of its own level substituted (positions
+    /// into positions, velocities into velocities, …), then remembered as `var`'s.
+    fn within_stage(&mut self, var: Var, value: Id) -> Id {
+        let same_level = |v: &Var| {
+            matches!(
+                (v, var),
+                (Var::Q(_), Var::Q(_)) | (Var::Qd(_), Var::Qd(_)) | (Var::Qdd(_), Var::Qdd(_))
+            )
+        };
+        let level: HashMap<Var, Id> = self
+            .local
+            .iter()
+            .filter(|(v, _)| same_level(v))
+            .map(|(&v, &e)| (v, e))
+            .collect();
+        let value = self.arena.substitute(value, &level, &mut HashMap::new());
+        self.local.insert(var, value);
+        value
+    }
+
+    /// `value` with the plan's substitutions; remembered as `var`'s value if it is constant.
+    fn forward(&mut self, var: Var, value: Id) -> Id {
+        let value = self.arena.substitute(value, &self.map, &mut HashMap::new());
+        if self.arena.is_invariant(value) {
+            self.map.insert(var, value);
+        }
+        value
+    }
+
+    /// `base_i − Σ_{k ∉ own} Φ_q[i, k] · rate(k)`, substituted: a rate right-hand side of row
+    /// `i` with the rates of earlier stages moved over.
+    fn rate_rhs(&mut self, base: Id, i: usize, own: &[usize], rate: fn(u32) -> Var) -> Id {
+        let mut rhs = base;
+        for (k, value) in self.rows[i].clone() {
+            if own.contains(&k) {
+                continue;
+            }
+            let r = self.arena.var(rate(index(k)));
+            let term = self.arena.mul(value, r);
+            rhs = self.arena.sub(rhs, term);
+        }
+        self.arena.substitute(rhs, &self.map, &mut HashMap::new())
+    }
+
+    fn block(&mut self, phi: &[Id], component: Component) -> Block {
+        let Component {
+            equations,
+            coordinates,
+        } = component;
+        let n = equations.len();
+        // Entries in the component's natural local order.
+        let mut natural = Vec::new();
+        for (r, &i) in equations.iter().enumerate() {
+            for (col, &c) in coordinates.iter().enumerate() {
+                let value = self.d.diff(self.arena, phi[i], Var::Q(index(c)));
+                if !self.arena.is_zero(value) {
+                    natural.push((r, col, value));
+                }
+            }
+        }
+        let values: Vec<Id> = natural.iter().map(|e| e.2).collect();
+        let sample = self.evaluate(&values, &self.sample.clone());
+        let constant: Vec<bool> = values
+            .iter()
+            .map(|&v| self.arena.as_const(v).is_some())
+            .collect();
+        let pattern: Vec<(usize, usize)> = natural.iter().map(|e| (e.0, e.1)).collect();
+        let (pivot_rows, pivot_columns) = factor::order(n, &pattern, &sample, &constant);
+        let (row_rank, column_rank) = (ranks(&pivot_rows), ranks(&pivot_columns));
+        let mut entries: Vec<(usize, usize, Id)> = natural
+            .iter()
+            .map(|&(r, c, v)| (row_rank[r], column_rank[c], v))
+            .collect();
+        entries.sort_by_key(|&(r, c, _)| (c, r));
+        let equations: Vec<usize> = pivot_rows.iter().map(|&r| equations[r]).collect();
+        let coordinates: Vec<usize> = pivot_columns.iter().map(|&c| coordinates[c]).collect();
+        let positions: Vec<(usize, usize)> = entries.iter().map(|&(r, c, _)| (r, c)).collect();
+        let factorization =
+            Some(Factorization::new(n, &positions)).filter(|f| f.updates() <= MAX_STATIC_UPDATES);
+        let residuals = equations.iter().map(|&i| phi[i]).collect();
+        let velocity_rhs = (self.outputs >= Outputs::Velocities).then(|| {
+            equations
+                .iter()
+                .map(|&i| {
+                    let nu = self.kin.nu.as_ref().map_or(self.arena.zero(), |nu| nu[i]);
+                    self.rate_rhs(nu, i, &coordinates, Var::Qd)
+                })
+                .collect()
+        });
+        let acceleration_rhs = (self.outputs >= Outputs::Accelerations).then(|| {
+            equations
+                .iter()
+                .map(|&i| {
+                    let gamma = self.kin.gamma.as_ref().map_or(self.arena.zero(), |g| g[i]);
+                    self.rate_rhs(gamma, i, &coordinates, Var::Qdd)
+                })
+                .collect()
+        });
+        Block {
+            equations,
+            coordinates,
+            residuals,
+            entries,
+            factorization,
+            velocity_rhs,
+            acceleration_rhs,
+        }
+    }
+
+    /// `roots` at positions `q`, t = 0 and the default parameters (NaN where undefined).
+    fn evaluate(&self, roots: &[Id], q: &[f64]) -> Vec<f64> {
+        let tape = Tape::new(self.arena, roots);
+        let mut out = vec![0.0; roots.len()];
+        let inputs = Inputs {
+            q,
+            qd: &[],
+            qdd: &[],
+            trig: &[],
+            t: 0.0,
+            params: &self.params,
+        };
+        tape.eval(inputs, &mut tape.scratch(), &mut out);
+        out
+    }
+}
+
+/// `ranks[p[k]] = k` for a permutation `p`.
+fn ranks(permutation: &[usize]) -> Vec<usize> {
+    let mut ranks = vec![0; permutation.len()];
+    for (k, &p) in permutation.iter().enumerate() {
+        ranks[p] = k;
+    }
+    ranks
+}
+
+fn index(k: usize) -> u32 {
+    u32::try_from(k).unwrap_or(u32::MAX)
+}

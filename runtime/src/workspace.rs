@@ -1,0 +1,228 @@
+//! The solver's scratch storage, sized by the scene: vectors of the largest block's size, the
+//! largest block's factor values, two dense matrices of the largest block's size (the partial
+//! pivoting fallback and Levenberg–Marquardt), and a word per stage.
+//!
+//! Nothing here grows with the number of coordinates: a 6,000-coordinate scene whose largest
+//! coupled block has 6 coordinates needs a few hundred bytes besides its state vectors.
+
+/// Storage the solver borrows for one solve. Implemented by [`Buffers`] (inline arrays, for
+/// generated scenes), [`crate::DenseBuffers`] (the dense reference) and, with the `alloc`
+/// feature, [`VecBuffers`] (the interpreter); the solver is its only user.
+pub trait Workspace {
+    /// Every buffer at once, as disjoint slices.
+    fn parts(&mut self) -> Parts<'_>;
+
+    /// The diagnosis of the last [`crate::SolveError::Singular`]: the row order buffer, whose
+    /// head the solver fills with the dependent equations, and the undetermined coordinates'
+    /// buffer.
+    fn diagnosis(&self) -> (&[usize], &[usize]);
+}
+
+/// The buffers of a [`Workspace`], each at least as long as the scene's largest block needs
+/// (B its size, S its factor values, K the number of stages), grouped so that the solver can
+/// borrow the groups separately.
+pub struct Parts<'a> {
+    pub(crate) newton: NewtonVectors<'a>,
+    pub(crate) scales: Scales<'a>,
+    pub(crate) factors: FactorStorage<'a>,
+    pub(crate) estimator: Estimator<'a>,
+    /// Scaled dense Jacobian for Levenberg–Marquardt and the rank reveal (B²).
+    pub(crate) dense: &'a mut [f64],
+    /// Row and column orders of the rank reveal; after a diagnosis, global indices (B each).
+    pub(crate) row_order: &'a mut [usize],
+    pub(crate) col_order: &'a mut [usize],
+    /// Per stage: the condition estimator's warm-start column (K).
+    pub(crate) hints: &'a mut [usize],
+    /// After a diagnosis: every undetermined coordinate (at most the scene's n), and per
+    /// stage whether it is downstream of the singular one (K).
+    pub(crate) undetermined: &'a mut [usize],
+    pub(crate) downstream: &'a mut [bool],
+    /// The trig cache ([`crate::Structured::fill_trig`]).
+    pub(crate) trig: &'a mut [f64],
+}
+
+/// The Newton iteration's vectors (B each).
+pub(crate) struct NewtonVectors<'a> {
+    /// Block residual Φ_b.
+    pub phi: &'a mut [f64],
+    /// Newton or Levenberg–Marquardt step.
+    pub step: &'a mut [f64],
+    /// The block's coordinates where the last step started.
+    pub base: &'a mut [f64],
+    /// Residual at a trial point; right-hand sides of derivative solves.
+    pub trial: &'a mut [f64],
+    /// Levenberg–Marquardt gradient.
+    pub gradient: &'a mut [f64],
+}
+
+/// Unit scales of a block's equations (D_r) and coordinates (D_c) (B each).
+pub(crate) struct Scales<'a> {
+    pub rows: &'a mut [f64],
+    pub cols: &'a mut [f64],
+}
+
+/// A block's factors: its Jacobian values and static factors (S), dense partial-pivoting
+/// factors (B²) and their row swaps (B).
+pub(crate) struct FactorStorage<'a> {
+    pub values: &'a mut [f64],
+    pub lu: &'a mut [f64],
+    pub swaps: &'a mut [usize],
+}
+
+/// The condition estimator's scratch (B each).
+pub(crate) struct Estimator<'a> {
+    pub x: &'a mut [f64],
+    pub signs: &'a mut [f64],
+}
+
+impl<'a> Parts<'a> {
+    /// Groups the buffers.
+    pub(crate) fn new(
+        [phi, step, base, trial, gradient, rows, cols, x, signs]: [&'a mut [f64]; 9],
+        [swaps, row_order, col_order]: [&'a mut [usize]; 3],
+        values: &'a mut [f64],
+        [lu, dense]: [&'a mut [f64]; 2],
+        (hints, undetermined, downstream): (&'a mut [usize], &'a mut [usize], &'a mut [bool]),
+        trig: &'a mut [f64],
+    ) -> Self {
+        Parts {
+            newton: NewtonVectors {
+                phi,
+                step,
+                base,
+                trial,
+                gradient,
+            },
+            scales: Scales { rows, cols },
+            factors: FactorStorage { values, lu, swaps },
+            estimator: Estimator { x, signs },
+            dense,
+            row_order,
+            col_order,
+            hints,
+            undetermined,
+            downstream,
+            trig,
+        }
+    }
+}
+
+/// Inline storage for a scene of `N` coordinates whose largest block has `B` coordinates and
+/// `S` factor values, solved in `K` stages with `T` cached sines and cosines: what generated
+/// code names as its [`crate::Structured::Workspace`].
+#[derive(Debug, Clone)]
+pub struct Buffers<const B: usize, const S: usize, const K: usize, const N: usize, const T: usize> {
+    vectors: [[f64; B]; 9],
+    indices: [[usize; B]; 3],
+    values: [f64; S],
+    matrices: [[[f64; B]; B]; 2],
+    hints: [usize; K],
+    undetermined: [usize; N],
+    downstream: [bool; K],
+    trig: [f64; T],
+}
+
+impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: usize>
+    Buffers<B, S, K, N, T>
+{
+    /// Zeroed buffers.
+    pub const fn new() -> Self {
+        Self {
+            vectors: [[0.0; B]; 9],
+            indices: [[0; B]; 3],
+            values: [0.0; S],
+            matrices: [[[0.0; B]; B]; 2],
+            hints: [usize::MAX; K],
+            undetermined: [0; N],
+            downstream: [false; K],
+            trig: [0.0; T],
+        }
+    }
+}
+
+impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: usize> Default
+    for Buffers<B, S, K, N, T>
+{
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: usize> Workspace
+    for Buffers<B, S, K, N, T>
+{
+    fn parts(&mut self) -> Parts<'_> {
+        let [lu, dense] = &mut self.matrices;
+        Parts::new(
+            self.vectors.each_mut().map(|v| &mut v[..]),
+            self.indices.each_mut().map(|v| &mut v[..]),
+            &mut self.values,
+            [lu.as_flattened_mut(), dense.as_flattened_mut()],
+            (
+                &mut self.hints,
+                &mut self.undetermined,
+                &mut self.downstream,
+            ),
+            &mut self.trig,
+        )
+    }
+
+    fn diagnosis(&self) -> (&[usize], &[usize]) {
+        (&self.indices[1], &self.undetermined)
+    }
+}
+
+/// Heap storage for scenes whose sizes are known only at run time (the interpreter).
+#[cfg(feature = "alloc")]
+#[derive(Debug, Clone)]
+pub struct VecBuffers {
+    vectors: [alloc::vec::Vec<f64>; 9],
+    indices: [alloc::vec::Vec<usize>; 3],
+    values: alloc::vec::Vec<f64>,
+    matrices: [alloc::vec::Vec<f64>; 2],
+    hints: alloc::vec::Vec<usize>,
+    undetermined: alloc::vec::Vec<usize>,
+    downstream: alloc::vec::Vec<bool>,
+    trig: alloc::vec::Vec<f64>,
+}
+
+#[cfg(feature = "alloc")]
+impl VecBuffers {
+    /// Buffers for a scene of `n` coordinates whose blocks have up to `block` coordinates and
+    /// `slots` factor values, in `stages` stages, with `trig` cached sines and cosines.
+    pub fn new(block: usize, slots: usize, stages: usize, n: usize, trig: usize) -> Self {
+        use alloc::vec;
+        Self {
+            vectors: core::array::from_fn(|_| vec![0.0; block]),
+            indices: core::array::from_fn(|_| vec![0; block]),
+            values: vec![0.0; slots],
+            matrices: core::array::from_fn(|_| vec![0.0; block * block]),
+            hints: vec![usize::MAX; stages],
+            undetermined: vec![0; n],
+            downstream: vec![false; stages],
+            trig: vec![0.0; trig],
+        }
+    }
+}
+
+#[cfg(feature = "alloc")]
+impl Workspace for VecBuffers {
+    fn parts(&mut self) -> Parts<'_> {
+        Parts::new(
+            self.vectors.each_mut().map(|v| &mut v[..]),
+            self.indices.each_mut().map(|v| &mut v[..]),
+            &mut self.values,
+            self.matrices.each_mut().map(|v| &mut v[..]),
+            (
+                &mut self.hints,
+                &mut self.undetermined,
+                &mut self.downstream,
+            ),
+            &mut self.trig,
+        )
+    }
+
+    fn diagnosis(&self) -> (&[usize], &[usize]) {
+        (&self.indices[1], &self.undetermined)
+    }
+}
