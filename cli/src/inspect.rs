@@ -1,6 +1,7 @@
 //! `mechgen check`: a readable summary of a compiled scene (coordinates, equations, degrees of
 //! freedom, Jacobian sparsity, length scale, parameters, branch invariants) and, with `--stats`,
-//! the operation counts of the generated functions.
+//! the solve structure (stages, block sizes, fill-in) and the operation counts of the generated
+//! functions.
 
 use core::fmt::{self, Write};
 
@@ -132,6 +133,10 @@ fn numbered(out: &mut String, names: &[String]) -> fmt::Result {
 }
 
 fn write_stats(out: &mut String, scene: &Scene) -> fmt::Result {
+    writeln!(out, "\nsolve structure:")?;
+    for line in mechgen::stats::structure(scene).lines() {
+        writeln!(out, "  {line}")?;
+    }
     writeln!(
         out,
         "\noperation counts per generated function (each shared sub-expression once):"
@@ -178,6 +183,10 @@ mod tests {
             "{text}"
         );
         assert!(text.contains("function"), "{text}");
+        assert!(
+            text.contains("solve structure:\n  6 coordinates in 2 stages: 6 explicit (3 fixed)"),
+            "{text}"
+        );
 
         let counts = mechgen::stats::function_counts(&scene);
         let names: Vec<_> = counts.iter().map(|f| f.function).collect();

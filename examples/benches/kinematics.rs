@@ -1,26 +1,43 @@
-//! Speed of generated code against the interpreter on the same IR, for the example scenes:
-//! evaluating Φ and Φ_q, and one full kinematic step (position, velocity, acceleration at one
-//! time, warm-started with the predictor) through the runtime's solver.
+//! Speed of the example scenes, in one run, against their hand-written closed forms
+//! (`mechgen_examples::closed_form`): the table of step ratios.
 //!
-//! The finite-difference and automatic-differentiation Jacobians of the accuracy report
-//! (`mechgen_examples::report`) are timed in the same groups, and steps use the report's
-//! reference setting (its tolerance and steps per revolution), so the report's per-call and
-//! per-step figures can be checked against these (the report prints criterion's beside its own).
+//! A *step* is what a user's loop pays per output time: for the seed and the four-bar, a
+//! `Simulation` step (q, q̇, q̈ at the next of 360 times per crank revolution, predictor on, the
+//! report's reference tolerance); for the offset slider, a positions-only solve at the next of
+//! 360 crank angles, warm-started from the last; for a closed form, its evaluation at that time
+//! or angle. Every revolution restarts from a checkpoint assembled at t = 0 (the copy is not
+//! timed), so all methods solve the same 360 states however long criterion runs: an endless run
+//! would reach huge times, where the predictor's time differences lose digits and the workload
+//! changes.
 //!
-//! The group `seed/safeguards` times one seed revolution (assembly and 360 steps) with the
-//! stability safeguards (unit scaling, condition estimate) on and off.
+//! Methods per scene: `closed_form`; `generated` (the emitted structured solve); `dense` (the
+//! same generated equations through the dense one-block reference); the accuracy report's
+//! Jacobian baselines around the same scene (finite differences, forward-mode AD, all dense);
+//! `naive` (the seed emitted without folding, simplification or sharing); `interpreted` (the
+//! CLI's interpreter on the scene's `.mech` twin). Besides `step`, each solver method times Φ,
+//! Φ_q and Φ+Φ_q at an assembled state, which the report prints beside its own figures.
+//!
+//! The group `seed/safeguards` times a seed step with the stability safeguards (unit scaling,
+//! condition estimate) on and off.
+//!
+//! After criterion's figures, the run prints each scene's fastest batch per step for
+//! `closed_form`, `generated` and `dense`, and their ratios: fastest batches, because the
+//! machines are shared and noise only ever adds time.
 //!
 //! `cargo bench -p mechgen-examples --bench kinematics`
 
+use std::cell::RefCell;
 use std::hint::black_box;
+use std::time::{Duration, Instant};
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{BenchmarkGroup, Criterion, measurement::WallTime};
 use mechgen_cli::Interpreted;
+use mechgen_examples::closed_form;
 use mechgen_examples::report::{AutoDiff, CentralDifference, ForwardDifference, Plan};
-use mechgen_examples::scenes::{FourBar, PistonCrank};
+use mechgen_examples::scenes::{FourBar, OffsetSlider, PistonCrank};
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{
-    Dense, Matrix, Simulation, Solver, SolverOptions, Storage, Structured, Vector,
+    Dense, Matrix, Mechanism, Simulation, Solver, SolverOptions, State, Storage, Structured, Vector,
 };
 
 /// The seed generated naively (no folding, no simplification, no shared sub-expressions) by
@@ -30,6 +47,56 @@ use mechgen_runtime::{
 #[allow(missing_docs, dead_code, clippy::all)]
 mod naive {
     include!(concat!(env!("OUT_DIR"), "/piston_crank_naive.rs"));
+}
+
+/// Output times (or angles) per crank revolution: the report's reference setting.
+const STEPS: u64 = 360;
+
+/// The fastest batch per step of each (scene, method) timed with [`time_steps`].
+#[derive(Default)]
+struct Fastest(RefCell<Vec<(String, f64)>>);
+
+impl Fastest {
+    fn record(&self, name: &str, seconds: f64) {
+        let mut all = self.0.borrow_mut();
+        match all.iter_mut().find(|(n, _)| n == name) {
+            Some((_, best)) => *best = best.min(seconds),
+            None => all.push((name.to_owned(), seconds)),
+        }
+    }
+
+    fn get(&self, name: &str) -> Option<f64> {
+        self.0.borrow().iter().find(|(n, _)| n == name).map(|p| p.1)
+    }
+}
+
+/// Times `step` as criterion's `step` in `group`: `step(run, k)` takes step k (1-based) of a
+/// revolution started from a copy of `start`, a new copy every [`STEPS`] steps.
+fn time_steps<S: Clone>(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    fastest: &Fastest,
+    name: &str,
+    start: &S,
+    mut step: impl FnMut(&mut S, u64),
+) {
+    group.bench_function("step", |b| {
+        b.iter_custom(|iterations| {
+            let mut total = Duration::ZERO;
+            let mut done = 0;
+            while done < iterations {
+                let chunk = (iterations - done).min(STEPS);
+                let mut run = start.clone();
+                let started = Instant::now();
+                for k in 1..=chunk {
+                    step(&mut run, k);
+                }
+                total += started.elapsed();
+                done += chunk;
+            }
+            fastest.record(name, total.as_secs_f64() / iterations as f64);
+            total
+        });
+    });
 }
 
 /// The IR of a scene's `.mech` twin.
@@ -43,58 +110,119 @@ fn interpreted(file: &str) -> Interpreted {
     Interpreted::new(&scene(file))
 }
 
-/// Benchmarks one mechanism under `label`: Φ, Φ_q, Φ+Φ_q at an assembled state, then a step.
-fn bench_scene<M>(c: &mut Criterion, label: &str, mechanism: M, period: f64)
-where
-    M: Structured + Clone,
+/// Φ, Φ_q and Φ+Φ_q of `mechanism` at `q`.
+fn equations<M: Mechanism>(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    mechanism: &M,
+    q: &Vector<M::Dim>,
+    t: f64,
+) where
     DefaultAllocator: Storage<M::Dim>,
 {
-    let reference = Plan::full().reference;
-    let mut simulation = Simulation::new(
-        Solver::with_options(mechanism.clone(), reference.options()),
-        0.0,
-    )
-    .expect("scene assembles");
-    let q = simulation.state().q.clone();
     let dim = mechanism.dim();
     let mut phi = Vector::<M::Dim>::zeros_generic(dim, mechgen_runtime::nalgebra::Const::<1>);
     let mut jacobian = Matrix::<M::Dim>::zeros_generic(dim, dim);
-    let t = 0.1 * period;
-
-    let mut group = c.benchmark_group(label);
     group.bench_function("phi", |b| {
-        b.iter(|| mechanism.phi(black_box(&q), black_box(t), &mut phi));
+        b.iter(|| mechanism.phi(black_box(q), black_box(t), &mut phi));
     });
     group.bench_function("jacobian", |b| {
-        b.iter(|| mechanism.jacobian(black_box(&q), black_box(t), &mut jacobian));
+        b.iter(|| mechanism.jacobian(black_box(q), black_box(t), &mut jacobian));
     });
     group.bench_function("phi_and_jacobian", |b| {
         b.iter(|| {
-            mechanism.phi_and_jacobian(black_box(&q), black_box(t), &mut phi, &mut jacobian);
+            mechanism.phi_and_jacobian(black_box(q), black_box(t), &mut phi, &mut jacobian);
         });
     });
-    // The report's reference steps per revolution (360, as in the examples); time keeps
-    // advancing across iterations.
-    let h = period / reference.steps as f64;
-    let mut time = 0.0;
-    group.bench_function("step", |b| {
-        b.iter(|| {
-            time += h;
-            let state = simulation.step_to(black_box(time)).expect("steps");
-            black_box(state.q[0]);
-        });
+}
+
+/// A driven scene through `Simulation` under `label`: Φ, Φ_q and Φ+Φ_q at the assembled state,
+/// then steps of a revolution of `period`.
+fn driven<M>(c: &mut Criterion, fastest: &Fastest, label: &str, mechanism: M, period: f64)
+where
+    M: Structured + Clone,
+    M::Workspace: Clone,
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let options = Plan::full().reference.options();
+    let checkpoint = Simulation::new(Solver::with_options(mechanism.clone(), options), 0.0)
+        .expect("scene assembles");
+    let mut group = c.benchmark_group(label);
+    equations(&mut group, &mechanism, &checkpoint.state().q, 0.1 * period);
+    simulation_steps(&mut group, fastest, label, &checkpoint, period);
+    group.finish();
+}
+
+/// Steps of a revolution of `period` from `checkpoint`.
+fn simulation_steps<M>(
+    group: &mut BenchmarkGroup<'_, WallTime>,
+    fastest: &Fastest,
+    label: &str,
+    checkpoint: &Simulation<M>,
+    period: f64,
+) where
+    M: Structured + Clone,
+    M::Workspace: Clone,
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let h = period / STEPS as f64;
+    time_steps(group, fastest, label, checkpoint, |simulation, k| {
+        let state = simulation.step_to(k as f64 * h).expect("steps");
+        black_box(state.q[0]);
+    });
+}
+
+/// A closed form's evaluation at the next of [`STEPS`] times (or angles) of a revolution.
+fn closed<F: Clone, R>(
+    c: &mut Criterion,
+    fastest: &Fastest,
+    label: &str,
+    form: F,
+    h: f64,
+    evaluate: impl Fn(&F, f64) -> R,
+) {
+    let mut group = c.benchmark_group(label);
+    time_steps(&mut group, fastest, label, &form, |form, k| {
+        black_box(evaluate(form, black_box(k as f64 * h)));
     });
     group.finish();
 }
 
-/// What the stability safeguards cost per seed step, measured in one group: unit scaling and the
-/// condition estimate, each switched off alone and together (the line search and the
-/// Levenberg–Marquardt fallback cost nothing until a step fails).
-fn safeguards(c: &mut Criterion) {
+/// The offset slider posed at the next of [`STEPS`] crank angles, warm-started from the last
+/// solve (its positions-only, time-free use).
+fn posed<M>(c: &mut Criterion, fastest: &Fastest, label: &str, mechanism: M, pose: fn(&mut M, f64))
+where
+    M: Structured + Clone,
+    M::Workspace: Clone,
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let mut solver = Solver::with_options(mechanism.clone(), Plan::full().reference.options());
+    let mut state = State::new(solver.mechanism());
+    solver.mechanism().initial_guess(&mut state.q);
+    pose(solver.mechanism_mut(), 0.0);
+    solver.solve_into(0.0, &mut state).expect("assembles");
+    let mut group = c.benchmark_group(label);
+    equations(&mut group, &mechanism, &state.q, 0.0);
+    let h = 2.0 * std::f64::consts::PI / STEPS as f64;
+    time_steps(
+        &mut group,
+        fastest,
+        label,
+        &(solver, state),
+        |(solver, state), k| {
+            pose(solver.mechanism_mut(), k as f64 * h);
+            solver.solve_into(0.0, state).expect("solves");
+            black_box(state.q[0]);
+        },
+    );
+    group.finish();
+}
+
+/// What the stability safeguards cost per seed step: unit scaling and the condition estimate,
+/// each switched off alone and together (the line search and the Levenberg–Marquardt fallback
+/// cost nothing until a step fails).
+fn safeguards(c: &mut Criterion, fastest: &Fastest) {
     let seed = PistonCrank::default();
     let period = 2.0 * std::f64::consts::PI / seed.omega;
-    let reference = Plan::full().reference;
-    let mut group = c.benchmark_group("seed/safeguards");
     for (label, scale_units, estimate_condition) in [
         ("scaling+condition", true, true),
         ("scaling", true, false),
@@ -104,94 +232,174 @@ fn safeguards(c: &mut Criterion) {
         let options = SolverOptions {
             scale_units,
             estimate_condition,
-            ..reference.options()
+            ..Plan::full().reference.options()
         };
-        // One revolution from assembly per iteration: every variant solves the same 361
-        // states (an endless run would drift to huge crank angles, a different workload).
-        group.bench_function(label, |b| {
-            b.iter(|| {
-                let solver = Solver::with_options(seed, options);
-                let mut simulation = Simulation::new(solver, 0.0).expect("scene assembles");
-                simulation
-                    .run(period, reference.steps, |state| {
-                        black_box(state.q[0]);
-                    })
-                    .expect("steps");
-            });
-        });
+        let checkpoint =
+            Simulation::new(Solver::with_options(seed, options), 0.0).expect("scene assembles");
+        let mut variant = c.benchmark_group(format!("seed/safeguards/{label}"));
+        simulation_steps(
+            &mut variant,
+            fastest,
+            &format!("seed/safeguards/{label}"),
+            &checkpoint,
+            period,
+        );
+        variant.finish();
     }
-    group.finish();
 }
 
-fn kinematics(c: &mut Criterion) {
-    let seed_period = 2.0 * std::f64::consts::PI / PistonCrank::default().omega;
-    bench_scene(c, "seed/generated", PistonCrank::default(), seed_period);
-    // The report's Jacobian baselines, around the same generated scene.
+fn seed(c: &mut Criterion, fastest: &Fastest) {
     let seed = PistonCrank::default();
-    bench_scene(
+    let period = 2.0 * std::f64::consts::PI / seed.omega;
+    let form = closed_form::PistonCrank::default();
+    closed(
         c,
+        fastest,
+        "seed/closed_form",
+        form,
+        period / STEPS as f64,
+        |f, t| f.kinematics(t),
+    );
+    driven(c, fastest, "seed/generated", seed, period);
+    driven(c, fastest, "seed/dense", Dense::new(seed), period);
+    driven(
+        c,
+        fastest,
         "seed/forward_difference",
         Dense::new(ForwardDifference::new(seed)),
-        seed_period,
+        period,
     );
-    bench_scene(
+    driven(
         c,
+        fastest,
         "seed/central_difference",
         Dense::new(CentralDifference::new(seed)),
-        seed_period,
+        period,
     );
-    let seed_ad = AutoDiff::new(seed, &scene("piston_crank.mech")).expect("twin scenes match");
-    bench_scene(c, "seed/autodiff", Dense::new(seed_ad), seed_period);
-    // The same seed emitted naively (no folding, no simplification, no sharing): what the lean
-    // emission saves, measured in the same run.
-    bench_scene(c, "seed/naive", naive::PistonCrank::default(), seed_period);
-    bench_scene(
+    let ad = AutoDiff::new(seed, &scene("piston_crank.mech")).expect("twin scenes match");
+    driven(c, fastest, "seed/autodiff", Dense::new(ad), period);
+    // The same seed emitted naively: what the lean emission saves, measured in the same run.
+    driven(
         c,
-        "seed/dense",
-        Dense::new(PistonCrank::default()),
-        seed_period,
+        fastest,
+        "seed/naive",
+        naive::PistonCrank::default(),
+        period,
     );
-    bench_scene(
+    driven(
         c,
+        fastest,
         "seed/interpreted",
         interpreted("piston_crank.mech"),
-        seed_period,
-    );
-    let four_bar_period = 2.0 * std::f64::consts::PI / FourBar::default().omega;
-    bench_scene(c, "four_bar/generated", FourBar::default(), four_bar_period);
-    let four_bar = FourBar::default();
-    bench_scene(
-        c,
-        "four_bar/forward_difference",
-        Dense::new(ForwardDifference::new(four_bar)),
-        four_bar_period,
-    );
-    bench_scene(
-        c,
-        "four_bar/central_difference",
-        Dense::new(CentralDifference::new(four_bar)),
-        four_bar_period,
-    );
-    let four_bar_ad = AutoDiff::new(four_bar, &scene("four_bar.mech")).expect("twin scenes match");
-    bench_scene(
-        c,
-        "four_bar/autodiff",
-        Dense::new(four_bar_ad),
-        four_bar_period,
-    );
-    bench_scene(
-        c,
-        "four_bar/interpreted",
-        interpreted("four_bar.mech"),
-        four_bar_period,
+        period,
     );
 }
 
-criterion_group! {
-    name = benches;
-    config = Criterion::default()
-        .warm_up_time(std::time::Duration::from_millis(500))
-        .measurement_time(std::time::Duration::from_secs(2));
-    targets = safeguards, kinematics
+fn four_bar(c: &mut Criterion, fastest: &Fastest) {
+    let four_bar = FourBar::default();
+    let period = 2.0 * std::f64::consts::PI / four_bar.omega;
+    let form = closed_form::FourBar::default();
+    closed(
+        c,
+        fastest,
+        "four_bar/closed_form",
+        form,
+        period / STEPS as f64,
+        |f, t| f.kinematics(t),
+    );
+    driven(c, fastest, "four_bar/generated", four_bar, period);
+    driven(c, fastest, "four_bar/dense", Dense::new(four_bar), period);
+    let forward = Dense::new(ForwardDifference::new(four_bar));
+    driven(c, fastest, "four_bar/forward_difference", forward, period);
+    let central = Dense::new(CentralDifference::new(four_bar));
+    driven(c, fastest, "four_bar/central_difference", central, period);
+    let ad = AutoDiff::new(four_bar, &scene("four_bar.mech")).expect("twin scenes match");
+    driven(c, fastest, "four_bar/autodiff", Dense::new(ad), period);
+    driven(
+        c,
+        fastest,
+        "four_bar/interpreted",
+        interpreted("four_bar.mech"),
+        period,
+    );
 }
-criterion_main!(benches);
+
+fn offset_slider(c: &mut Criterion, fastest: &Fastest) {
+    let form = closed_form::OffsetSlider::default();
+    let h = 2.0 * std::f64::consts::PI / STEPS as f64;
+    closed(
+        c,
+        fastest,
+        "offset_slider/closed_form",
+        form,
+        h,
+        |f, theta| f.q(theta),
+    );
+    let pose = |m: &mut OffsetSlider, theta: f64| m.crank_angle = theta;
+    posed(
+        c,
+        fastest,
+        "offset_slider/generated",
+        OffsetSlider::default(),
+        pose,
+    );
+    let pose_dense = |m: &mut Dense<OffsetSlider>, theta: f64| m.inner_mut().crank_angle = theta;
+    posed(
+        c,
+        fastest,
+        "offset_slider/dense",
+        Dense::new(OffsetSlider::default()),
+        pose_dense,
+    );
+}
+
+/// The ratio table: fastest batch per step against the scene's closed form.
+fn summary(fastest: &Fastest) {
+    println!("\nfastest batch per step (ns), and × the closed form:");
+    println!(
+        "  {:<28} {:>11} {:>11} {:>8} {:>11} {:>8}",
+        "scene", "closed form", "generated", "×", "dense", "×"
+    );
+    for (scene, what) in [
+        ("seed", "seed (q, q̇, q̈)"),
+        ("four_bar", "four-bar (q, q̇, q̈)"),
+        ("offset_slider", "offset slider (q)"),
+    ] {
+        let time = |method: &str| fastest.get(&format!("{scene}/{method}"));
+        let Some(base) = time("closed_form") else {
+            continue;
+        };
+        let cell = |t: Option<f64>| match t {
+            Some(t) => format!("{:>11.1} {:>8.2}", t * 1e9, t / base),
+            None => format!("{:>11} {:>8}", "—", "—"),
+        };
+        println!(
+            "  {what:<28} {:>11.1} {} {}",
+            base * 1e9,
+            cell(time("generated")),
+            cell(time("dense"))
+        );
+    }
+    let safeguards = fastest.get("seed/safeguards/scaling+condition");
+    if let (Some(on), Some(off)) = (safeguards, fastest.get("seed/safeguards/neither")) {
+        println!(
+            "  seed safeguards (scaling + condition estimate): {:.1} ns per step ({:+.1} %)",
+            (on - off) * 1e9,
+            100.0 * (on / off - 1.0)
+        );
+    }
+}
+
+fn main() {
+    let mut c = Criterion::default()
+        .warm_up_time(Duration::from_millis(500))
+        .measurement_time(Duration::from_secs(2))
+        .configure_from_args();
+    let fastest = Fastest::default();
+    seed(&mut c, &fastest);
+    four_bar(&mut c, &fastest);
+    offset_slider(&mut c, &fastest);
+    safeguards(&mut c, &fastest);
+    c.final_summary();
+    summary(&fastest);
+}

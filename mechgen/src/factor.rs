@@ -104,6 +104,10 @@ pub fn order(
     (pivot_rows, pivot_columns)
 }
 
+/// A candidate pivot's rank: (vanishes at the sample, Markowitz count, not a constant, minus
+/// its ratio to its column's largest entry).
+type Key = (bool, usize, bool, f64);
+
 /// The best pivot of the active submatrix; see [`order`].
 fn choose(
     rows: &[BTreeMap<usize, (f64, bool)>],
@@ -119,8 +123,8 @@ fn choose(
                 .fold(0.0, f64::max)
         })
         .collect();
-    // (vanishes, Markowitz count, not constant, −ratio, i, j): smallest wins.
-    let mut best: Option<((bool, usize, bool, f64), (usize, usize))> = None;
+    // Smallest wins: (vanishes, Markowitz count, not constant, −ratio); then the first seen.
+    let mut best: Option<(Key, (usize, usize))> = None;
     for (i, row) in rows.iter().enumerate() {
         let row_count = row.len();
         for (&j, &(value, is_constant)) in row {
@@ -135,7 +139,7 @@ fn choose(
             }
             let vanishes = value == 0.0;
             let count = (row_count - 1) * (columns[j].len() - 1);
-            let key = (vanishes, count, !is_constant, -ratio);
+            let key: Key = (vanishes, count, !is_constant, -ratio);
             let better = match &best {
                 None => true,
                 Some((k, _)) => {
@@ -260,19 +264,25 @@ impl Factorization {
         self.steps.iter().map(|s| s.updates.len()).sum()
     }
 
-    /// Factors `v` (at least [`Factorization::slots`] long) in place.
+    /// Factors `v` (at least [`Factorization::slots`] long) in place: L's multipliers below the
+    /// diagonal, U above, and each pivot's reciprocal on the diagonal.
     ///
     /// # Errors
     /// The first step whose pivot is not above `tiny` in magnitude or one of whose multipliers
     /// exceeds `limit` in magnitude (NaN fails both).
+    // `!(x > tiny)` and `!(x <= limit)`: NaN fails the tests.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
     pub fn factor(&self, v: &mut [f64], tiny: f64, limit: f64) -> Result<(), usize> {
         for (k, step) in self.steps.iter().enumerate() {
             let pivot = v[step.pivot];
             if !(pivot.abs() > tiny) {
                 return Err(k);
             }
+            // Stored as its reciprocal: one division per pivot, none in the solves.
+            let inverse = 1.0 / pivot;
+            v[step.pivot] = inverse;
             for &(_, s) in &step.lower {
-                v[s] /= pivot;
+                v[s] *= inverse;
             }
             if !step.lower.iter().all(|&(_, s)| v[s].abs() <= limit) {
                 return Err(k);
@@ -297,7 +307,7 @@ impl Factorization {
             }
         }
         for (k, step) in self.steps.iter().enumerate().rev() {
-            x[k] /= v[step.pivot];
+            x[k] *= v[step.pivot];
             for &(i, s) in &self.upper_columns[k] {
                 x[i] -= v[s] * x[k];
             }
@@ -310,7 +320,7 @@ impl Factorization {
             for &(i, s) in &self.upper_columns[k] {
                 x[k] -= v[s] * x[i];
             }
-            x[k] /= v[step.pivot];
+            x[k] *= v[step.pivot];
         }
         for (k, step) in self.steps.iter().enumerate().rev() {
             for &(i, s) in &step.lower {
@@ -331,7 +341,7 @@ mod tests {
         let mut u = vec![0.0; n * n];
         for (k, step) in f.steps.iter().enumerate() {
             l[k + k * n] = 1.0;
-            u[k + k * n] = v[step.pivot];
+            u[k + k * n] = 1.0 / v[step.pivot];
             for &(i, s) in &step.lower {
                 l[i + k * n] = v[s];
             }
@@ -422,15 +432,15 @@ mod tests {
         let b = [1.0, -2.0, 0.5];
         let mut x = b;
         f.solve(&v, &mut x);
-        for i in 0..3 {
+        for (i, b_i) in b.iter().enumerate() {
             let ax: f64 = (0..3).map(|j| dense(i, j) * x[j]).sum();
-            assert!((ax - b[i]).abs() < 1e-14, "row {i}");
+            assert!((ax - b_i).abs() < 1e-14, "row {i}");
         }
         let mut y = b;
         f.solve_transpose(&v, &mut y);
-        for j in 0..3 {
+        for (j, b_j) in b.iter().enumerate() {
             let aty: f64 = (0..3).map(|i| dense(i, j) * y[i]).sum();
-            assert!((aty - b[j]).abs() < 1e-14, "column {j}");
+            assert!((aty - b_j).abs() < 1e-14, "column {j}");
         }
     }
 

@@ -1,5 +1,6 @@
-//! Operation counts of generated code, so that a regression in what a function computes shows up
-//! in review (doc comments and snapshots) rather than only in a benchmark.
+//! What generated code computes, for review (doc comments, snapshots, `mechgen check --stats`):
+//! the operation counts of each function, so that a regression shows up in review rather than
+//! only in a benchmark, and the solve structure (stages, block sizes, fill-in).
 
 use std::fmt;
 
@@ -148,6 +149,131 @@ pub fn table(scene: &Scene) -> String {
             "{:<17}{:>8}{:>6}{:>6}{:>8}{:>6}{:>6}{:>6}{:>6}\n",
             f.function, f.outputs, c.trig, c.sqrt, c.exp_ln, c.mul, c.add, c.div, c.neg
         );
+    }
+    out
+}
+
+/// The solve structure as text: a summary line, then one line per stage (kind, size, the static
+/// LU's entries, fill-in and updates, and what it solves); scenes with many stages show the
+/// first and last ones and a histogram of block sizes.
+pub fn structure(scene: &Scene) -> String {
+    use crate::structure::Stage;
+    const SHOWN: usize = 24;
+    let (model, plan) = (&scene.model, &scene.plan);
+    let arena = &model.arena;
+    let (coordinates, equations) = (model.coordinate_names(), model.equation_names());
+    let fixed = |assignments: &[crate::structure::Assignment]| {
+        assignments.iter().all(|a| arena.is_invariant(a.position))
+    };
+    let explicit: usize = plan.assignments().count();
+    let fixed_count: usize = plan
+        .stages
+        .iter()
+        .filter_map(|s| match s {
+            Stage::Explicit(a) if fixed(a) => Some(a.len()),
+            _ => None,
+        })
+        .sum();
+    let blocks: Vec<&crate::structure::Block> = plan.blocks().collect();
+    let in_blocks: usize = blocks.iter().map(|b| b.equations.len()).sum();
+    let (entries, fill, updates) =
+        blocks
+            .iter()
+            .fold((0, 0, 0), |(e, f, u), b| match &b.factorization {
+                Some(lu) => (e + lu.entries, f + lu.fill(), u + lu.updates()),
+                None => (e + b.entries.len(), f, u),
+            });
+    let dense = blocks.iter().filter(|b| b.factorization.is_none()).count();
+    let mut out = format!(
+        "{} coordinates in {} stages: {explicit} explicit ({fixed_count} fixed), {in_blocks} in \
+         {} Newton block{} (largest {})\nstatic LU: {entries} Jacobian entries, {fill} fill-in, \
+         {updates} update{}{}; trig cache: {} angle{}\n",
+        model.dim(),
+        plan.stages.len(),
+        blocks.len(),
+        if blocks.len() == 1 { "" } else { "s" },
+        blocks.iter().map(|b| b.equations.len()).max().unwrap_or(0),
+        if updates == 1 { "" } else { "s" },
+        if dense > 0 {
+            format!(
+                " ({dense} block{} factored with partial pivoting)",
+                if dense == 1 { "" } else { "s" }
+            )
+        } else {
+            String::new()
+        },
+        plan.trig.angles.len(),
+        if plan.trig.angles.len() == 1 { "" } else { "s" },
+    );
+    out += &format!(
+        "{:>6}  {:<9}{:>5}{:>9}{:>6}{:>9}  solves (coordinate ← equation)\n",
+        "stage", "kind", "size", "entries", "fill", "updates"
+    );
+    let pairs = |cs: &[usize], es: &[usize]| {
+        let shown: Vec<String> = cs
+            .iter()
+            .zip(es)
+            .take(3)
+            .map(|(&c, &e)| format!("{} ← {}", coordinates[c], equations[e]))
+            .collect();
+        let more = if cs.len() > 3 { ", …" } else { "" };
+        format!("{}{more}", shown.join(", "))
+    };
+    let count = plan.stages.len();
+    for (s, stage) in plan.stages.iter().enumerate() {
+        if count > SHOWN && s == SHOWN - 8 {
+            out += &format!("{:>6}  … {} more stages\n", "", count - SHOWN);
+        }
+        if count > SHOWN && s >= SHOWN - 8 && s < count - 8 {
+            continue;
+        }
+        out += &match stage {
+            Stage::Explicit(a) => {
+                let cs: Vec<usize> = a.iter().map(|a| a.coordinate).collect();
+                let es: Vec<usize> = a.iter().map(|a| a.equation).collect();
+                let kind = if fixed(a) { "fixed" } else { "explicit" };
+                format!(
+                    "{s:>6}  {kind:<9}{:>5}{:>9}{:>6}{:>9}  {}\n",
+                    a.len(),
+                    "",
+                    "",
+                    "",
+                    pairs(&cs, &es)
+                )
+            }
+            Stage::Block(b) => {
+                let (e, f, u) = match &b.factorization {
+                    Some(lu) => (
+                        lu.entries.to_string(),
+                        lu.fill().to_string(),
+                        lu.updates().to_string(),
+                    ),
+                    None => (b.entries.len().to_string(), "-".into(), "dense".into()),
+                };
+                format!(
+                    "{s:>6}  {:<9}{:>5}{e:>9}{f:>6}{u:>9}  {}\n",
+                    "block",
+                    b.equations.len(),
+                    pairs(&b.coordinates, &b.equations)
+                )
+            }
+        };
+    }
+    if count > SHOWN {
+        let mut sizes: Vec<usize> = blocks.iter().map(|b| b.equations.len()).collect();
+        sizes.sort_unstable();
+        let mut histogram = Vec::new();
+        for size in sizes {
+            match histogram.last_mut() {
+                Some((s, n)) if *s == size => *n += 1,
+                _ => histogram.push((size, 1)),
+            }
+        }
+        let histogram: Vec<String> = histogram
+            .iter()
+            .map(|(size, n)| format!("{n} of {size}"))
+            .collect();
+        out += &format!("block sizes: {}\n", histogram.join(", "));
     }
     out
 }

@@ -60,6 +60,8 @@ pub struct TrigCache {
     pub nodes: Vec<(Id, Id)>,
     /// The stage that fills each slot.
     pub filled_by: Vec<usize>,
+    /// The slot of each cached node (`sin q_k` at `2m`, `cos q_k` at `2m + 1`).
+    pub slot: HashMap<Id, usize>,
 }
 
 /// When a kernel of a stage runs: before the stage's positions are known (explicit positions,
@@ -101,16 +103,12 @@ impl TrigCache {
             Phase::Positions => self.filled_by[m] < stage,
             Phase::After => self.filled_by[m] <= stage,
         };
-        let slot: HashMap<Id, usize> = self
-            .nodes
-            .iter()
-            .enumerate()
-            .filter(|&(m, _)| ready(m))
-            .flat_map(|(m, &(sin, cos))| [(sin, 2 * m), (cos, 2 * m + 1)])
-            .collect();
         crate::interpret::topological_order(arena, roots)
             .into_iter()
-            .filter_map(|id| slot.get(&id).map(|&i| (id, i)))
+            .filter_map(|id| {
+                let &i = self.slot.get(&id)?;
+                ready(i / 2).then_some((id, i))
+            })
             .collect()
     }
 }
@@ -319,7 +317,7 @@ fn trig_cache(arena: &mut Arena, stages: &[Stage], n: usize) -> TrigCache {
         }
     }
     let angles: Vec<usize> = (0..n).filter(|&k| wanted[k]).collect();
-    let nodes = angles
+    let nodes: Vec<(Id, Id)> = angles
         .iter()
         .map(|&k| {
             let q = arena.var(Var::Q(index(k)));
@@ -327,10 +325,16 @@ fn trig_cache(arena: &mut Arena, stages: &[Stage], n: usize) -> TrigCache {
         })
         .collect();
     let filled_by = angles.iter().map(|&k| stage_of[k]).collect();
+    let slot = nodes
+        .iter()
+        .enumerate()
+        .flat_map(|(m, &(sin, cos))| [(sin, 2 * m), (cos, 2 * m + 1)])
+        .collect();
     TrigCache {
         angles,
         nodes,
         filled_by,
+        slot,
     }
 }
 

@@ -18,9 +18,9 @@
 use nalgebra::DefaultAllocator;
 
 use crate::lu::{self, LuError};
-use crate::mechanism::{Storage, Unit, Vector};
+use crate::mechanism::{LengthScale, Storage, Vector};
 use crate::solver::SolverOptions;
-use crate::structure::{Block, Structured};
+use crate::structure::{Block, Pattern, Structured};
 use crate::workspace::{Estimator, FactorStorage, Scales};
 
 /// The scale below which a block's entries count as small: the unit-scaled Jacobian's own.
@@ -76,19 +76,15 @@ where
         self.block.len()
     }
 
-    /// Writes D_r (1/Lᵖ per equation) and D_c (Lᵖ per coordinate) for the block, `length`
-    /// being the scene's length scale rounded to a power of two (so scaling is exact).
-    pub fn set_scales(&self, scales: &mut Scales<'_>, length: f64) {
-        let power = |unit: Unit| match unit.length_power() {
-            0 => 1.0,
-            1 => length,
-            _ => length * length,
-        };
+    /// Writes D_r (L⁻ᵖ per equation), D_c (Lᵖ per coordinate) and D_c⁻¹ for the block.
+    pub fn set_scales(&self, scales: &mut Scales<'_>, length: &LengthScale) {
         for (r, &e) in scales.rows.iter_mut().zip(self.block.equations) {
-            *r = 1.0 / power(self.m.equation_unit(e));
+            *r = length.inverse_of(self.m.equation_unit(e));
         }
-        for (c, &j) in scales.cols.iter_mut().zip(self.block.coordinates) {
-            *c = power(self.m.coordinate_unit(j));
+        let cols = scales.cols.iter_mut().zip(scales.inverse_cols.iter_mut());
+        for ((c, inverse), &j) in cols.zip(self.block.coordinates) {
+            let unit = self.m.coordinate_unit(j);
+            (*c, *inverse) = (length.of(unit), length.inverse_of(unit));
         }
     }
 
@@ -114,8 +110,7 @@ where
         let sums = &mut sums[..n];
         sums.fill(0.0);
         let (mut largest, mut finite) = (0.0_f64, true);
-        for (k, value) in values.iter_mut().enumerate().take(self.block.entries()) {
-            let (i, j) = self.block.position(k);
+        let mut scale_entry = |value: &mut f64, i: usize, j: usize, sums: &mut [f64]| {
             let s = *value * scales.rows[i] * scales.cols[j];
             *value = s;
             let magnitude = s.abs();
@@ -126,6 +121,20 @@ where
                 largest
             };
             sums[j] += magnitude;
+        };
+        match self.block.pattern {
+            Pattern::Sparse(entries) => {
+                for (value, &(i, j)) in values.iter_mut().zip(entries) {
+                    scale_entry(value, i, j, sums);
+                }
+            }
+            Pattern::Dense => {
+                for (j, column) in values[..n * n].chunks_exact_mut(n.max(1)).enumerate() {
+                    for (i, value) in column.iter_mut().enumerate() {
+                        scale_entry(value, i, j, sums);
+                    }
+                }
+            }
         }
         if !finite {
             return Err(LuError::NonFinite);
@@ -183,10 +192,14 @@ where
     /// Copies the block's values into the column-major n × n `dense`, zeros elsewhere.
     pub fn scatter(&self, values: &[f64], dense: &mut [f64]) {
         let n = self.n();
-        dense.fill(0.0);
-        for (k, &value) in values.iter().enumerate().take(self.block.entries()) {
-            let (i, j) = self.block.position(k);
-            dense[i + j * n] = value;
+        match self.block.pattern {
+            Pattern::Sparse(entries) => {
+                dense.fill(0.0);
+                for (&value, &(i, j)) in values.iter().zip(entries) {
+                    dense[i + j * n] = value;
+                }
+            }
+            Pattern::Dense => dense[..n * n].copy_from_slice(&values[..n * n]),
         }
     }
 
@@ -323,6 +336,7 @@ where
 }
 
 /// `x ← diag(s) x`.
+#[inline]
 fn scale(x: &mut [f64], s: &[f64]) {
     for (x, s) in x.iter_mut().zip(s) {
         *x *= s;

@@ -254,11 +254,12 @@ fn copy(from: &[f64], to: &mut [f64]) {
 
 /// The workspace of a [`Dense`] mechanism: n × n matrices on the stack for `Const`
 /// dimensions (allocated once for `Dyn`).
+#[derive(Clone)]
 pub struct DenseBuffers<D: nalgebra::Dim>
 where
     DefaultAllocator: Storage<D>,
 {
-    vectors: [Vector<D>; 9],
+    vectors: [Vector<D>; 10],
     indices: [OVector<usize, D>; 3],
     values: Matrix<D>,
     matrices: [Matrix<D>; 2],

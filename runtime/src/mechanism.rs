@@ -53,25 +53,53 @@ pub enum Outputs {
 /// The solver scales by it so that convergence, pivoting and the condition estimate do not depend
 /// on the length unit: lengths are divided by the scene's [`Mechanism::length_scale`], areas by
 /// its square, angles are left alone. A scene in metres and the same scene in millimetres then
-/// take the same Newton steps and report the same condition number.
+/// take the same Newton steps and report the same condition number. The discriminant is the
+/// power of length.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Unit {
     /// Radians (θ coordinates, angle drivers, a prismatic joint's relative angle).
-    Angle,
+    Angle = 0,
     /// A length (x, y coordinates, point-coincidence equations, position drivers).
-    Length,
+    Length = 1,
     /// A length squared (a distance joint's `|d|² − L²`).
-    Area,
+    Area = 2,
 }
 
 impl Unit {
     /// The power of length this unit carries (0, 1 or 2).
     pub fn length_power(self) -> i32 {
-        match self {
-            Self::Angle => 0,
-            Self::Length => 1,
-            Self::Area => 2,
+        self as i32
+    }
+}
+
+/// The scene's length scale L, a power of two (so scaling by it is exact), to the power of each
+/// [`Unit`] and its inverse: looked up per coordinate and equation on every solve, so computed
+/// once per solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct LengthScale {
+    powers: [f64; 3],
+    inverses: [f64; 3],
+}
+
+impl LengthScale {
+    /// The scale for a length `length` (a power of two).
+    pub fn new(length: f64) -> Self {
+        let inverse = 1.0 / length;
+        Self {
+            powers: [1.0, length, length * length],
+            inverses: [1.0, inverse, inverse * inverse],
         }
+    }
+
+    /// Lᵖ for a unit of length power p: a value of this unit in scene units times this is
+    /// the value in the scene's unit.
+    pub fn of(&self, unit: Unit) -> f64 {
+        self.powers[unit as usize]
+    }
+
+    /// L⁻ᵖ: a value of this unit, in scene units.
+    pub fn inverse_of(&self, unit: Unit) -> f64 {
+        self.inverses[unit as usize]
     }
 }
 

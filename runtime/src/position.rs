@@ -27,7 +27,7 @@ use crate::block::{BlockSolve, Factors};
 use crate::error::{Quantity, SolveError};
 use crate::lu::{self, LuError};
 use crate::mechanism::{Storage, Vector};
-use crate::solver::{SolverOptions, non_finite};
+use crate::solver::{SolverOptions, all_finite, non_finite};
 use crate::structure::Structured;
 use crate::workspace::Parts;
 
@@ -91,6 +91,8 @@ pub(crate) struct Newton<'a, 'w, M> {
     pub t: f64,
     /// Factorisations whose static pivots failed and were redone with partial pivoting.
     pub fallbacks: usize,
+    /// Evaluations (and factorisations) of the block's Jacobian.
+    pub evaluations: usize,
 }
 
 impl<M: Structured> Newton<'_, '_, M>
@@ -172,7 +174,7 @@ where
                 &self.parts.scales,
                 self.parts.newton.step,
             );
-            let length = scaled_max(&self.parts.newton.step[..n], self.parts.scales.cols);
+            let length = scaled_max(&self.parts.newton.step[..n], self.parts.scales.inverse_cols);
             if !length.is_finite() {
                 return Err(non_finite(self.t, Quantity::Step));
             }
@@ -217,6 +219,7 @@ where
             parts.estimator.x,
             self.options,
         );
+        self.evaluations += 1;
         if factored.is_ok_and(Factors::fell_back) {
             self.fallbacks += 1;
         }
@@ -235,7 +238,7 @@ where
 
     fn check_phi(&self) -> Result<(), SolveError> {
         let n = self.bs.n();
-        if self.parts.newton.phi[..n].iter().all(|x| x.is_finite()) {
+        if all_finite(&self.parts.newton.phi[..n]) {
             Ok(())
         } else {
             Err(non_finite(self.t, Quantity::Phi))
@@ -254,7 +257,7 @@ where
     fn magnitude(&self, q: &Vector<M::Dim>) -> f64 {
         let q = q.as_slice();
         let values = self.bs.block.coordinates.iter().map(|&j| q[j]);
-        scaled_max_iter(values, self.parts.scales.cols).max(1.0)
+        scaled_max_iter(values, self.parts.scales.inverse_cols).max(1.0)
     }
 
     /// `base ← q_b`.
@@ -609,6 +612,7 @@ fn normal_matrix(j: &[f64], n: usize, mu: f64, a: &mut [f64]) {
 }
 
 /// (‖D_r v‖₂, ‖D_r v‖∞).
+#[inline]
 pub(crate) fn scaled_norms(v: &[f64], rows: &[f64]) -> (f64, f64) {
     let (mut sum, mut max) = (0.0_f64, 0.0_f64);
     for (x, r) in v.iter().zip(rows) {
@@ -621,18 +625,20 @@ pub(crate) fn scaled_norms(v: &[f64], rows: &[f64]) -> (f64, f64) {
 
 /// ‖D_c⁻¹ v‖∞: a step or a position in scene lengths and radians; a NaN entry makes it NaN, so
 /// that callers see a non-finite step rather than a small one.
-pub(crate) fn scaled_max(v: &[f64], cols: &[f64]) -> f64 {
-    scaled_max_iter(v.iter().copied(), cols)
+#[inline]
+pub(crate) fn scaled_max(v: &[f64], inverse_cols: &[f64]) -> f64 {
+    scaled_max_iter(v.iter().copied(), inverse_cols)
 }
 
-fn scaled_max_iter(v: impl Iterator<Item = f64>, cols: &[f64]) -> f64 {
-    v.zip(cols).fold(0.0, |m, (x, c)| {
-        let y = (x / c).abs();
+fn scaled_max_iter(v: impl Iterator<Item = f64>, inverse_cols: &[f64]) -> f64 {
+    v.zip(inverse_cols).fold(0.0, |m, (x, c)| {
+        let y = (x * c).abs();
         if y > m || y.is_nan() { y } else { m }
     })
 }
 
 /// ‖v‖∞.
+#[inline]
 pub(crate) fn max_abs(v: &[f64]) -> f64 {
     v.iter().fold(0.0, |m, x| m.max(x.abs()))
 }

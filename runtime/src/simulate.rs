@@ -4,7 +4,7 @@
 use nalgebra::DefaultAllocator;
 
 use crate::error::{Quantity, SolveError};
-use crate::mechanism::{Outputs, Storage, Vector};
+use crate::mechanism::{Mechanism, Outputs, Storage, Vector};
 use crate::solver::Solver;
 use crate::state::State;
 use crate::structure::Structured;
@@ -24,16 +24,17 @@ pub const DEFAULT_MAX_HALVINGS: u32 = 10;
 
 /// A solver plus the last solved state, advanced with [`Simulation::step_to`].
 ///
-/// Holds three states and swaps them, so stepping never allocates and a failed step leaves the
-/// last good state untouched.
+/// Holds three states and alternates between two of them, so stepping never allocates (nor
+/// copies a state) and a failed step leaves the last good state untouched.
 pub struct Simulation<M: Structured>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
     solver: Solver<M>,
-    current: State<M>,
-    /// Scratch for the next solve; after a step it holds the state before `current`.
-    next: State<M>,
+    /// The current state, `states[newest]`, and the scratch for the next solve, which after a
+    /// step holds the state before the current one.
+    states: [State<M>; 2],
+    newest: usize,
     /// The state a sub-stepped step started from, restored if it fails.
     saved: State<M>,
     /// The last prediction, to measure how far Newton moved from it.
@@ -42,6 +43,26 @@ where
     has_previous: bool,
     predictor: bool,
     max_halvings: u32,
+}
+
+/// A checkpoint: the copy continues from the same state, with the same history.
+impl<M: Structured + Clone> Clone for Simulation<M>
+where
+    M::Workspace: Clone,
+    DefaultAllocator: Storage<M::Dim>,
+{
+    fn clone(&self) -> Self {
+        Self {
+            solver: self.solver.clone(),
+            states: self.states.clone(),
+            newest: self.newest,
+            saved: self.saved.clone(),
+            prediction: self.prediction.clone(),
+            has_previous: self.has_previous,
+            predictor: self.predictor,
+            max_halvings: self.max_halvings,
+        }
+    }
 }
 
 /// How one predicted solve ended.
@@ -66,18 +87,18 @@ where
         solver.solve_into(t0, &mut current)?;
         current.substeps = 1;
         Ok(Self {
-            next: current.clone(),
             saved: current.clone(),
             prediction: current.q.clone(),
+            states: [current.clone(), current],
+            newest: 0,
             solver,
-            current,
             has_previous: false,
             predictor: true,
             max_halvings: DEFAULT_MAX_HALVINGS,
         })
     }
 
-    /// Turns the second-order predictor on or off (off: each solve starts from the last `q`).
+    /// Turns the third-order predictor on or off (off: each solve starts from the last `q`).
     pub fn set_predictor(&mut self, on: bool) {
         self.predictor = on;
     }
@@ -95,7 +116,7 @@ where
 
     /// The last solved state.
     pub fn state(&self) -> &State<M> {
-        &self.current
+        &self.states[self.newest]
     }
 
     /// The solver (and through it the mechanism).
@@ -144,38 +165,42 @@ where
             Outcome::Jumped if self.max_halvings == 0 => self.accept(),
             Outcome::Failed(_) | Outcome::Jumped => return self.substep(t),
         }
-        self.current.substeps = 1;
-        Ok(&self.current)
+        let current = &mut self.states[self.newest];
+        current.substeps = 1;
+        Ok(current)
     }
 
     /// Reaches `t_end` in sub-steps from `current`; see [`Simulation::step_to`].
     fn substep(&mut self, t_end: f64) -> Result<&State<M>, SolveError> {
-        self.saved.copy_from(&self.current);
-        let t_start = self.current.t;
+        self.saved.copy_from(&self.states[self.newest]);
+        let t_start = self.saved.t;
         let shortest = (t_end - t_start).abs() / (1_u64 << self.max_halvings) as f64;
         let mut h = 0.5 * (t_end - t_start);
         let (mut substeps, mut iterations, mut fallbacks, mut successes) = (0, 0, 0, 0);
         loop {
-            let remaining = t_end - self.current.t;
+            let reached = self.states[self.newest].t;
+            let remaining = t_end - reached;
             if remaining == 0.0 {
-                self.current.substeps = substeps;
-                self.current.iterations = iterations;
-                self.current.fallbacks = fallbacks;
-                return Ok(&self.current);
+                let current = &mut self.states[self.newest];
+                current.substeps = substeps;
+                current.iterations = iterations;
+                current.fallbacks = fallbacks;
+                return Ok(current);
             }
             // Within a hair of the end, take the end exactly rather than leave a sliver.
             let target = if remaining.abs() <= 1.000_001 * h.abs() {
                 t_end
             } else {
-                self.current.t + h
+                reached + h
             };
             // At the shortest sub-step a jump is accepted: continuation from the last state is
             // as close to the motion as stepping can get (declared branches are still checked).
             let finest = 0.5 * h.abs() < shortest;
             match self.advance(target, finest) {
                 Outcome::Solved => {
-                    (substeps, iterations) = (substeps + 1, iterations + self.current.iterations);
-                    fallbacks += self.current.fallbacks;
+                    let current = &self.states[self.newest];
+                    (substeps, iterations) = (substeps + 1, iterations + current.iterations);
+                    fallbacks += current.fallbacks;
                     successes += 1;
                     // Two good sub-steps in a row: try a longer one (never beyond half the step).
                     if successes >= 2 && 2.0 * h.abs() <= 0.5 * (t_end - t_start).abs() {
@@ -183,7 +208,7 @@ where
                     }
                 }
                 Outcome::Failed(error) if !error.is_step_related() || finest => {
-                    self.current.copy_from(&self.saved);
+                    self.states[self.newest].copy_from(&self.saved);
                     return Err(error);
                 }
                 Outcome::Failed(_) | Outcome::Jumped => (h, successes) = (0.5 * h, 0),
@@ -194,52 +219,22 @@ where
     /// One predicted solve at `t` into `next`; on success `next` becomes `current`, except for
     /// a suspected jump, which is left unaccepted unless `accept_jump`.
     fn advance(&mut self, t: f64, accept_jump: bool) -> Outcome {
-        let (current, next) = (&self.current, &mut self.next);
-        let h = t - current.t;
-        let (q, qd, qdd) = (
-            current.q.as_slice(),
-            current.velocities.as_slice(),
-            current.accelerations.as_slice(),
-        );
-        // The previous state, still held in `next`, gives one more derivative by a difference:
-        // the secant slope for positions-only scenes, q̈ from two velocities, the jerk from two
-        // accelerations.
-        let h_prev = current.t - next.t;
-        let history = self.has_previous && h_prev != 0.0 && h_prev.is_finite();
-        let outputs = current.outputs();
-        let predicted = self.predictor
-            && match outputs {
-                Outputs::Positions => history,
-                Outputs::Velocities | Outputs::Accelerations => true,
-            };
-        let (qd_prev, qdd_prev) = (next.velocities.as_slice(), next.accelerations.as_slice());
-        let (h2, h3) = (0.5 * h * h, h * h * h / 6.0);
-        let ratio = h / h_prev;
-        let mut guesses = next.q.as_mut_slice().iter_mut();
-        for (k, guess) in guesses.by_ref().enumerate() {
-            *guess = match outputs {
-                _ if !predicted => q[k],
-                Outputs::Accelerations if history => {
-                    let jerk = (qdd[k] - qdd_prev[k]) / h_prev;
-                    q[k] + h * qd[k] + h2 * qdd[k] + h3 * jerk
-                }
-                Outputs::Accelerations => q[k] + h * qd[k] + h2 * qdd[k],
-                Outputs::Velocities if history => {
-                    q[k] + h * qd[k] + h2 * (qd[k] - qd_prev[k]) / h_prev
-                }
-                Outputs::Velocities => q[k] + h * qd[k],
-                Outputs::Positions => q[k] + (q[k] - *guess) * ratio,
-            };
+        let (current, next) = pair(&mut self.states, self.newest);
+        let predicted = self.predictor && predict(current, next, self.has_previous, t);
+        if predicted {
+            self.prediction.copy_from(&next.q);
+        } else {
+            next.q.copy_from(&current.q);
         }
-        let motion = self.solver.block_distance(&next.q, &current.q);
-        self.prediction.copy_from(&next.q);
         // From here `next` no longer holds the previous state, whatever the outcome.
         self.has_previous = false;
-        if let Err(error) = self.solver.solve_into(t, &mut self.next) {
+        if let Err(error) = self.solver.solve_into(t, next) {
             return Outcome::Failed(error);
         }
         if predicted && !accept_jump {
-            let correction = self.solver.block_distance(&self.next.q, &self.prediction);
+            let (motion, correction) =
+                self.solver
+                    .block_distances(&current.q, &self.prediction, &next.q);
             let options = self.solver.options();
             let floor = JUMP_FLOOR + 10.0 * (options.residual_tolerance + options.step_tolerance);
             if correction > JUMP_FRACTION * motion + floor {
@@ -251,7 +246,7 @@ where
     }
 
     fn accept(&mut self) {
-        core::mem::swap(&mut self.current, &mut self.next);
+        self.newest = 1 - self.newest;
         self.has_previous = true;
     }
 
@@ -266,14 +261,89 @@ where
         steps: usize,
         mut visit: impl FnMut(&State<M>),
     ) -> Result<(), SolveError> {
-        visit(&self.current);
-        let t_start = self.current.t;
+        visit(&self.states[self.newest]);
+        let t_start = self.states[self.newest].t;
         for k in 1..=steps {
             let state = self.step_to(sample_time(t_start, t_end, steps, k))?;
             visit(state);
         }
         Ok(())
     }
+}
+
+/// The state at `newest` and the other one.
+fn pair<T>(states: &mut [T; 2], newest: usize) -> (&T, &mut T) {
+    let [a, b] = states;
+    if newest == 0 { (a, b) } else { (b, a) }
+}
+
+/// Writes the predicted positions at `t` into `next.q` and says whether it did (otherwise
+/// `next` is untouched): the Taylor expansion from `current` with the derivatives the scene
+/// computes, plus one more from the difference with the previous state, which `next` still
+/// holds when `history` (the secant slope for positions-only scenes, q̈ from two velocities,
+/// the jerk from two accelerations). A positions-only scene without history has nothing to
+/// predict with.
+fn predict<M: Mechanism>(current: &State<M>, next: &mut State<M>, history: bool, t: f64) -> bool
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let h = t - current.t;
+    let h_prev = current.t - next.t;
+    let history = history && h_prev != 0.0 && h_prev.is_finite();
+    let (q, qd, qdd) = (
+        current.q.as_slice(),
+        current.velocities.as_slice(),
+        current.accelerations.as_slice(),
+    );
+    let State {
+        q: guess,
+        velocities: qd_prev,
+        accelerations: qdd_prev,
+        ..
+    } = next;
+    let guess = guess.as_mut_slice();
+    let h2 = 0.5 * h * h;
+    // Coefficients hoisted out of the loops: one division per step, none per coordinate.
+    match current.outputs() {
+        Outputs::Positions if !history => return false,
+        Outputs::Positions => {
+            let ratio = h / h_prev;
+            for (g, &q) in guess.iter_mut().zip(q) {
+                *g = q + (q - *g) * ratio;
+            }
+        }
+        Outputs::Velocities if history => {
+            let c = h2 / h_prev;
+            let rates = qd.iter().zip(qd_prev.as_slice());
+            for ((g, &q), (&v, &v_prev)) in guess.iter_mut().zip(q).zip(rates) {
+                *g = q + h * v + c * (v - v_prev);
+            }
+        }
+        Outputs::Velocities => {
+            for ((g, &q), &v) in guess.iter_mut().zip(q).zip(qd) {
+                *g = q + h * v;
+            }
+        }
+        Outputs::Accelerations => {
+            let c = if history {
+                h * h * h / (6.0 * h_prev)
+            } else {
+                0.0
+            };
+            let previous = qdd_prev.as_slice();
+            for (k, g) in guess.iter_mut().enumerate() {
+                // Without history the jerk term is left out, not multiplied by zero: `next`
+                // may hold a failed solve's non-finite iterate.
+                let jerk = if history {
+                    c * (qdd[k] - previous[k])
+                } else {
+                    0.0
+                };
+                *g = q[k] + h * qd[k] + h2 * qdd[k] + jerk;
+            }
+        }
+    }
+    true
 }
 
 /// The k-th of `steps` equal steps from `t0` to `t_end`: `t0 + k·(t_end − t0)/steps`, computed

@@ -9,7 +9,7 @@ use nalgebra::{DefaultAllocator, Dim};
 use crate::block::{BlockSolve, Factors};
 use crate::error::{Described, Quantity, SolveError};
 use crate::lu::DEFAULT_PIVOT_TOLERANCE;
-use crate::mechanism::{Accelerations, Outputs, Storage, Vector, Velocities};
+use crate::mechanism::{Accelerations, LengthScale, Outputs, Storage, Vector, Velocities};
 use crate::position::{Newton, Solved};
 use crate::state::State;
 use crate::structure::{Stage, Structured};
@@ -95,6 +95,10 @@ pub struct Convergence {
     /// Block factorisations whose static pivots failed their test and were redone with partial
     /// pivoting.
     pub fallbacks: usize,
+    /// Evaluations and factorisations of block Jacobians, summed over the blocks: one per
+    /// Newton iteration, plus one at the returned positions unless the last correction was of
+    /// round-off size (its factors then serve the rates).
+    pub evaluations: usize,
 }
 
 impl Convergence {
@@ -104,10 +108,12 @@ impl Convergence {
             residual: 0.0,
             condition: if estimate_condition { 1.0 } else { f64::NAN },
             fallbacks: 0,
+            evaluations: 0,
         }
     }
 
-    fn add(&mut self, block: &Solved, fallbacks: usize) {
+    fn add(&mut self, block: &Solved, newton: (usize, usize)) {
+        let (fallbacks, evaluations) = newton;
         self.iterations = self.iterations.max(block.iterations);
         self.residual = self.residual.max(block.residual);
         // NaN (estimate off) stays NaN.
@@ -117,6 +123,7 @@ impl Convergence {
             self.condition
         };
         self.fallbacks += fallbacks;
+        self.evaluations += evaluations;
     }
 }
 
@@ -132,10 +139,28 @@ where
     pub(crate) options: SolverOptions,
     workspace: M::Workspace,
     /// The length scale of the last solve, rounded to a power of two.
-    length: f64,
+    length: LengthScale,
     /// How many dependent equations and undetermined coordinates the last diagnosis found
     /// (heads of the workspace's diagnosis buffers).
     diagnosed: (usize, usize),
+}
+
+/// A copy with its own workspace (to run the same scene on another thread, or to restart
+/// from a checkpoint).
+impl<M: Structured + Clone> Clone for Solver<M>
+where
+    M::Workspace: Clone,
+    DefaultAllocator: Storage<M::Dim>,
+{
+    fn clone(&self) -> Self {
+        Self {
+            mechanism: self.mechanism.clone(),
+            options: self.options,
+            workspace: self.workspace.clone(),
+            length: self.length,
+            diagnosed: self.diagnosed,
+        }
+    }
 }
 
 /// What a stage sweep computes besides positions.
@@ -171,7 +196,7 @@ where
             workspace: mechanism.workspace(),
             mechanism,
             options,
-            length: 1.0,
+            length: LengthScale::new(1.0),
             diagnosed: (0, 0),
         }
     }
@@ -318,26 +343,26 @@ where
         let mut total = Convergence::start(options.estimate_condition);
         for s in 0..m.stage_count() {
             match m.stage(s) {
-                Some(Stage::Explicit { coordinates, .. }) => {
+                Some(Stage::Explicit { .. }) => {
                     m.assign_positions(s, q, parts.trig, t);
-                    check_entries(q, coordinates, t, Quantity::Phi)?;
                     m.fill_trig(s, q, parts.trig);
-                    assign_rates(m, s, coordinates, q, parts.trig, qd, qdd, t, rates)?;
+                    assign_rates(m, s, q, parts.trig, qd, qdd, t, rates);
                 }
                 Some(Stage::Block(block)) => {
                     let bs = BlockSolve { m, stage: s, block };
-                    bs.set_scales(&mut parts.scales, *length);
+                    bs.set_scales(&mut parts.scales, length);
                     let mut newton = Newton {
                         bs,
                         parts: &mut parts,
                         options,
                         t,
                         fallbacks: 0,
+                        evaluations: 0,
                     };
                     let solved = newton
                         .solve(q, rates != Rates::None)
                         .map_err(|e| record(e, m, s, newton.parts, diagnosed))?;
-                    total.add(&solved, newton.fallbacks);
+                    total.add(&solved, (newton.fallbacks, newton.evaluations));
                     m.fill_trig(s, q, newton.parts.trig);
                     block_rates(
                         &newton.bs,
@@ -353,6 +378,10 @@ where
                 None => break,
             }
         }
+        // Blocks check what they solve; an explicit assignment's non-finite value shows here
+        // (or earlier, as the non-finite Φ or rate of a block that reads it).
+        check_finite(q, t, Quantity::Phi)?;
+        check_rates(qd, qdd, t, rates)?;
         check_branches(m, q, parts.trig, t)?;
         Ok(total)
     }
@@ -381,19 +410,20 @@ where
         let mut parts = workspace.parts();
         for s in 0..m.stage_count() {
             match m.stage(s) {
-                Some(Stage::Explicit { coordinates, .. }) => {
+                Some(Stage::Explicit { .. }) => {
                     m.fill_trig(s, q, parts.trig);
-                    assign_rates(m, s, coordinates, q, parts.trig, qd, qdd, t, rates)?;
+                    assign_rates(m, s, q, parts.trig, qd, qdd, t, rates);
                 }
                 Some(Stage::Block(block)) => {
                     let bs = BlockSolve { m, stage: s, block };
-                    bs.set_scales(&mut parts.scales, *length);
+                    bs.set_scales(&mut parts.scales, length);
                     let mut newton = Newton {
                         bs,
                         parts: &mut parts,
                         options,
                         t,
                         fallbacks: 0,
+                        evaluations: 0,
                     };
                     let factors = newton
                         .factor_at(q)
@@ -404,7 +434,7 @@ where
                 None => break,
             }
         }
-        Ok(())
+        check_rates(qd, qdd, t, rates)
     }
 
     /// ‖D_c⁻¹ (a − b)‖∞: how far apart two configurations are, in scene lengths and radians
@@ -413,10 +443,16 @@ where
         self.distance_over(a, b, 0..a.len().min(b.len()))
     }
 
-    /// [`Solver::scaled_distance`] over the coordinates of the Newton blocks only: those on
-    /// which a solve can choose a branch (explicit assignments have one solution), so where a
-    /// jump to another branch shows.
-    pub(crate) fn block_distance(&self, a: &Vector<M::Dim>, b: &Vector<M::Dim>) -> f64 {
+    /// [`Solver::scaled_distance`] from `prediction` to `previous` and to `solved` (the
+    /// motion predicted and the correction Newton made), over the coordinates of the Newton
+    /// blocks only: those on which a solve can choose a branch (explicit assignments have one
+    /// solution), so where a jump to another branch shows.
+    pub(crate) fn block_distances(
+        &self,
+        previous: &Vector<M::Dim>,
+        prediction: &Vector<M::Dim>,
+        solved: &Vector<M::Dim>,
+    ) -> (f64, f64) {
         let m = &self.mechanism;
         let coordinates = (0..m.stage_count())
             .filter_map(|s| match m.stage(s) {
@@ -425,7 +461,22 @@ where
             })
             .flatten()
             .copied();
-        self.distance_over(a, b, coordinates)
+        let (previous, prediction, solved) = (
+            previous.as_slice(),
+            prediction.as_slice(),
+            solved.as_slice(),
+        );
+        let (mut motion, mut correction) = (0.0, 0.0);
+        for j in coordinates {
+            let (Some(x), Some(p), Some(s)) = (prediction.get(j), previous.get(j), solved.get(j))
+            else {
+                continue;
+            };
+            let power = self.length.inverse_of(m.coordinate_unit(j));
+            motion = larger(motion, ((x - p) * power).abs());
+            correction = larger(correction, ((x - s) * power).abs());
+        }
+        (motion, correction)
     }
 
     fn distance_over(
@@ -435,21 +486,13 @@ where
         coordinates: impl Iterator<Item = usize>,
     ) -> f64 {
         let m = &self.mechanism;
-        // The length is a power of two: its reciprocal is exact.
-        let inverse = 1.0 / self.length;
-        let powers = [1.0, inverse, inverse * inverse];
         let (a, b) = (a.as_slice(), b.as_slice());
         coordinates.fold(0.0, |largest, j| {
             let (Some(x), Some(y)) = (a.get(j), b.get(j)) else {
                 return largest;
             };
-            let power = m.coordinate_unit(j).length_power().clamp(0, 2) as usize;
-            let d = ((x - y) * powers[power]).abs();
-            if d > largest || d.is_nan() {
-                d
-            } else {
-                largest
-            }
+            let power = self.length.inverse_of(m.coordinate_unit(j));
+            larger(largest, ((x - y) * power).abs())
         })
     }
 
@@ -466,11 +509,11 @@ where
     /// The scene's length scale from the current parameters, rounded to a power of two so that
     /// scaling adds no rounding error (1 with unit scaling off).
     fn update_scale(&mut self) {
-        self.length = if self.options.scale_units {
+        self.length = LengthScale::new(if self.options.scale_units {
             power_of_two(self.mechanism.length_scale())
         } else {
             1.0
-        };
+        });
     }
 
     /// Length and finiteness of an input, and finiteness of `t`.
@@ -589,30 +632,43 @@ where
     error
 }
 
-/// The rates of an explicit stage's coordinates.
+/// The rates of an explicit stage's coordinates (checked at the end of the sweep).
 #[allow(clippy::too_many_arguments)]
 fn assign_rates<M: Structured>(
     m: &M,
     stage: usize,
-    coordinates: &[usize],
     q: &Vector<M::Dim>,
     trig: &[f64],
     qd: &mut Vector<M::Dim>,
     qdd: &mut Vector<M::Dim>,
     t: f64,
     rates: Rates,
-) -> Result<(), SolveError>
-where
+) where
     DefaultAllocator: Storage<M::Dim>,
 {
-    if rates == Rates::None {
-        return Ok(());
+    if rates != Rates::None {
+        m.assign_velocities(stage, q, trig, qd, t);
     }
-    m.assign_velocities(stage, q, trig, qd, t);
-    check_entries(qd, coordinates, t, Quantity::Velocity)?;
     if rates == Rates::Both {
         m.assign_accelerations(stage, q, trig, qd, qdd, t);
-        check_entries(qdd, coordinates, t, Quantity::Acceleration)?;
+    }
+}
+
+/// The rates asked for are finite.
+fn check_rates<D: Dim>(
+    qd: &Vector<D>,
+    qdd: &Vector<D>,
+    t: f64,
+    rates: Rates,
+) -> Result<(), SolveError>
+where
+    DefaultAllocator: Storage<D>,
+{
+    if rates != Rates::None {
+        check_finite(qd, t, Quantity::Velocity)?;
+    }
+    if rates == Rates::Both {
+        check_finite(qdd, t, Quantity::Acceleration)?;
     }
     Ok(())
 }
@@ -706,6 +762,15 @@ fn power_of_two(length: f64) -> f64 {
     f64::from_bits(length.to_bits() & 0xfff0_0000_0000_0000)
 }
 
+/// The larger of two distances, NaN winning.
+fn larger(largest: f64, d: f64) -> f64 {
+    if d > largest || d.is_nan() {
+        d
+    } else {
+        largest
+    }
+}
+
 pub(crate) fn non_finite(time: f64, quantity: Quantity) -> SolveError {
     SolveError::NonFinite { time, quantity }
 }
@@ -721,33 +786,31 @@ where
     check_slice(v.as_slice(), t, quantity)
 }
 
+#[inline]
 fn check_slice(v: &[f64], t: f64, quantity: Quantity) -> Result<(), SolveError> {
-    if v.iter().all(|x| x.is_finite()) {
+    if all_finite(v) {
         Ok(())
     } else {
         Err(non_finite(t, quantity))
     }
 }
 
-/// The entries `indices` of `v` are finite.
-fn check_entries<D: Dim>(
-    v: &Vector<D>,
-    indices: &[usize],
-    t: f64,
-    quantity: Quantity,
-) -> Result<(), SolveError>
-where
-    DefaultAllocator: Storage<D>,
-{
-    let v = v.as_slice();
-    if indices
-        .iter()
-        .all(|&j| v.get(j).is_some_and(|x| x.is_finite()))
-    {
-        Ok(())
-    } else {
-        Err(non_finite(t, quantity))
+/// Whether every entry is finite, without a branch per entry: `x · 0` is NaN exactly for an
+/// infinite or NaN `x`, and four independent sums of them keep the loop short.
+#[inline]
+pub(crate) fn all_finite(v: &[f64]) -> bool {
+    let mut sums = [0.0; 4];
+    let chunks = v.chunks_exact(4);
+    let rest = chunks.remainder();
+    for chunk in chunks {
+        for (sum, x) in sums.iter_mut().zip(chunk) {
+            *sum += x * 0.0;
+        }
     }
+    for (sum, x) in sums.iter_mut().zip(rest) {
+        *sum += x * 0.0;
+    }
+    !(sums[0] + sums[1] + sums[2] + sums[3]).is_nan()
 }
 
 #[cfg(test)]
@@ -777,6 +840,23 @@ mod tests {
     }
 
     #[test]
+    fn all_finite_finds_any_infinite_or_nan_entry() {
+        for n in 0..=9 {
+            let mut storage = [1.5; 9];
+            let v = &mut storage[..n];
+            assert!(all_finite(v));
+            for k in 0..n {
+                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+                    v[k] = bad;
+                    assert!(!all_finite(v), "{bad} at {k} of {n}");
+                }
+                v[k] = -f64::MAX;
+            }
+            assert!(all_finite(v));
+        }
+    }
+
+    #[test]
     fn newton_converges_quadratically_to_the_closed_form() {
         let mut solver = dense(Pendulum::default());
         let mut guess = Vector::zeros_generic(nalgebra::Const, U1);
@@ -790,6 +870,34 @@ mod tests {
         let convergence = solver.solve_position(&mut q, 0.7).unwrap();
         assert_eq!(convergence.iterations, 1);
         assert!(convergence.residual <= 1e-15);
+    }
+
+    #[test]
+    fn factors_are_reused_only_after_a_round_off_correction() {
+        let mut solver = dense(Pendulum::default());
+        let exact = Vector::from(solver.mechanism().inner().exact(0.7)[0]);
+        // With the rates: the factors at the result are needed.
+        let evaluations = |solver: &mut Solver<Reference>, nudge: f64| {
+            let mut q = exact;
+            q[2] += nudge;
+            let (mut qd, mut qdd) = (q, q);
+            let convergence = solver
+                .solve_stages(0.7, &mut q, &mut qd, &mut qdd, Rates::Both)
+                .unwrap();
+            (convergence.iterations, convergence.evaluations)
+        };
+        // From the solution: one update of round-off size, its factors kept.
+        assert_eq!(evaluations(&mut solver, 0.0), (1, 1));
+        // 1e-9 off: the second correction is ~1e-18, negligible: two evaluations.
+        assert_eq!(evaluations(&mut solver, 1e-9), (2, 2));
+        // 1e-6 off: the second correction (~1e-13) ends the iteration but is not negligible:
+        // the block is evaluated and factored once more at the result.
+        assert_eq!(evaluations(&mut solver, 1e-6), (2, 3));
+        // Positions alone need no factors at the result.
+        let mut q = exact;
+        q[2] += 1e-6;
+        let convergence = solver.solve_position(&mut q, 0.7).unwrap();
+        assert_eq!((convergence.iterations, convergence.evaluations), (2, 2));
     }
 
     #[test]

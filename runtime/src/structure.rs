@@ -90,25 +90,6 @@ impl Block<'_> {
     pub fn is_empty(&self) -> bool {
         self.equations.is_empty()
     }
-
-    /// Number of Jacobian values [`Structured::block_jacobian`] writes.
-    pub fn entries(&self) -> usize {
-        match self.pattern {
-            Pattern::Sparse(entries) => entries.len(),
-            Pattern::Dense => self.len() * self.len(),
-        }
-    }
-
-    /// Local `(row, column)` of value `k`.
-    pub fn position(&self, k: usize) -> (usize, usize) {
-        match self.pattern {
-            Pattern::Sparse(entries) => entries.get(k).copied().unwrap_or((0, 0)),
-            Pattern::Dense => {
-                let n = self.len().max(1);
-                (k % n, k / n)
-            }
-        }
-    }
 }
 
 /// A mechanism with a solve structure: the stages the solver works through, and the kernels it
@@ -227,6 +208,8 @@ where
 
     /// Writes a block's acceleration right-hand side, `γ_b − Φ_q[b, earlier] q̈_earlier`, from
     /// the block's and earlier velocities and earlier accelerations.
+    // Each argument is one input the kernel may read; bundling them would only rename them.
+    #[allow(clippy::too_many_arguments)]
     fn acceleration_rhs(
         &self,
         _stage: usize,

@@ -1,5 +1,6 @@
 //! Snapshot tests of the code generated for every example scene (`examples/scenes/*.mech`): the
-//! formatted Rust, and a table of the operations each generated function performs.
+//! formatted Rust, a table of the operations each generated function performs, and the solve
+//! structure (stages, blocks, their static LU).
 //!
 //! A change to the generator shows up here as a reviewable diff of the emitted code, and a
 //! regression in what a function computes (more trigonometry, a lost shared sub-expression) as
@@ -86,4 +87,17 @@ fn operation_table(source: &str) -> Result<String, mechgen::Errors> {
     table += "\nnaive (no folding or simplification, every use evaluated):\n";
     table += &mechgen::stats::table(&naive);
     Ok(table)
+}
+
+#[test]
+fn solve_structure() {
+    for path in scenes() {
+        let source = fs::read_to_string(&path).expect("readable scene");
+        let scene = mechgen::compile_str(&source)
+            .unwrap_or_else(|e| panic!("{} does not compile:\n{e}", path.display()));
+        let structure = mechgen::stats::structure(&scene);
+        with_scene_settings(&path, || {
+            insta::assert_snapshot!(format!("{}_structure", stem(&path)), structure);
+        });
+    }
 }

@@ -247,18 +247,17 @@ fn branch_method(cx: &Context<'_>, plan: &Plan) -> TokenStream {
     }
 }
 
-/// A trait method's match arms, and the parameters they read.
+/// A trait method's arms (stage, statements), and the parameters they read.
 #[derive(Default)]
 struct Dispatch {
-    arms: Vec<TokenStream>,
+    arms: Vec<(usize, TokenStream)>,
     reads: BTreeSet<&'static str>,
 }
 
 impl Dispatch {
-    /// `stage => …,` calling a kernel with `arguments` (by name).
-    fn push(&mut self, s: usize, call: TokenStream, arguments: &[&'static str]) {
-        let stage = idx(s);
-        self.arms.push(quote! { #stage => #call, });
+    /// The statements for stage `s`, calling a kernel with `arguments` (by name).
+    fn push(&mut self, s: usize, statements: TokenStream, arguments: &[&'static str]) {
+        self.arms.push((s, statements));
         self.reads.insert("stage");
         self.reads.extend(arguments);
     }
@@ -297,12 +296,9 @@ impl Dispatch {
         });
         let name = format_ident!("{}", name);
         let arrow = result.as_ref().map(|r| quote!(-> #r));
-        let fallback = if result.is_some() {
-            quote!(::core::result::Result::Err(0))
-        } else {
-            quote!({})
-        };
-        let arms = &self.arms;
+        let fallback = result
+            .is_some()
+            .then(|| quote!(::core::result::Result::Err(0)));
         let trig = self.reads.contains("trig").then(|| {
             let view = if writes_trig {
                 quote!(first_chunk_mut)
@@ -320,10 +316,22 @@ impl Dispatch {
                 };
             }
         });
-        let body = if arms.is_empty() {
-            fallback
-        } else {
-            quote! { #trig match #stage { #(#arms)* _ => #fallback } }
+        let body = match &self.arms[..] {
+            [] => quote!(#fallback),
+            // One stage: `if`, not a one-arm `match` (clippy's `single_match` in included code).
+            [(s, statements)] => {
+                let s = idx(*s);
+                let otherwise = fallback.as_ref().map(|f| quote!(else { #f }));
+                quote! { #trig if #stage == #s { #statements } #otherwise }
+            }
+            arms => {
+                let arms = arms.iter().map(|(s, statements)| {
+                    let s = idx(*s);
+                    quote! { #s => { #statements } }
+                });
+                let fallback = fallback.unwrap_or_else(|| quote!({}));
+                quote! { #trig match #stage { #(#arms)* _ => #fallback } }
+            }
         };
         quote! {
             fn #name(&self, #stage: usize, #(#params),*) #arrow {
@@ -335,6 +343,7 @@ impl Dispatch {
 
 /// The `STAGES` constant, documented stage by stage.
 fn stage_table(model: &Model, plan: &Plan) -> TokenStream {
+    let (coordinates, equations) = (model.coordinate_names(), model.equation_names());
     let list = |indices: &[usize]| -> TokenStream {
         let indices = indices.iter().map(|&i| idx(i));
         quote!(&[#(#indices),*])
@@ -345,7 +354,7 @@ fn stage_table(model: &Model, plan: &Plan) -> TokenStream {
     ];
     let entries = plan.stages.iter().enumerate().map(|(s, stage)| {
         docs.push(String::new());
-        let mut lines = stage_lines(model, stage).into_iter();
+        let mut lines = stage_lines(stage, &coordinates, &equations).into_iter();
         docs.push(format!(" {s}. {}", lines.next().unwrap_or_default()));
         docs.extend(lines.map(|l| format!(" {l}")));
         match stage {
@@ -433,8 +442,7 @@ fn block_headline(block: &Block) -> String {
 }
 
 /// The doc lines of a stage: a headline, then what it solves for.
-fn stage_lines(model: &Model, stage: &Stage) -> Vec<String> {
-    let (coordinates, equations) = (model.coordinate_names(), model.equation_names());
+fn stage_lines(stage: &Stage, coordinates: &[String], equations: &[String]) -> Vec<String> {
     let (headline, coords, eqs) = match stage {
         Stage::Explicit(assignments) => (
             format!(
@@ -452,9 +460,13 @@ fn stage_lines(model: &Model, stage: &Stage) -> Vec<String> {
         ),
     };
     let mut lines = vec![headline];
-    lines.extend(name_lines(&coords, &coordinates, Some((&eqs, &equations))));
+    lines.extend(name_lines(&coords, coordinates, Some((&eqs, equations))));
     lines
 }
+
+/// A level of a stage's kernels: its name, its outputs' values (if the scene computes it) and
+/// the inputs it may read.
+type Level = (&'static str, Option<Vec<Id>>, &'static [&'static str]);
 
 /// The per-stage functions and the trait methods' dispatch.
 struct Kernels<'p> {
@@ -541,7 +553,7 @@ impl<'p> Kernels<'p> {
             &[("trig", quote!(&mut [f64; #trig_len]))],
         );
         let call = kernel.call();
-        self.fill_trig.push(s, call, &kernel.arguments);
+        self.fill_trig.push(s, quote!(#call;), &kernel.arguments);
     }
 
     /// A kernel writing `outputs`: it takes the `inputs` (`q`, `qd`, `qdd`, `t`) its body reads,
@@ -606,7 +618,7 @@ impl<'p> Kernels<'p> {
 
     fn explicit(&mut self, cx: &Context<'_>, s: usize, assignments: &[Assignment]) {
         let vector = cx.vector_type();
-        let levels: [(&str, Option<Vec<Id>>, &[&'static str]); 3] = [
+        let levels: [Level; 3] = [
             (
                 "positions",
                 Some(assignments.iter().map(|a| a.position).collect()),
@@ -703,19 +715,24 @@ impl<'p> Kernels<'p> {
         self.jacobian.push(
             s,
             quote! {
-                if let (#some(phi), #some(values)) =
+                let (#some(phi), #some(values)) =
                     (phi.first_chunk_mut::<#n>(), values.first_chunk_mut::<#slots>())
-                {
-                    #call;
-                }
+                else {
+                    return;
+                };
+                #call;
             },
             &kernel.arguments,
         );
 
         // Rate right-hand sides.
-        let rates: [(&str, &Option<Vec<Id>>, &[&'static str]); 2] = [
-            ("velocity", &block.velocity_rhs, &["q", "qd"]),
-            ("acceleration", &block.acceleration_rhs, &["q", "qd", "qdd"]),
+        let rates: [Level; 2] = [
+            ("velocity", block.velocity_rhs.clone(), &["q", "qd"]),
+            (
+                "acceleration",
+                block.acceleration_rhs.clone(),
+                &["q", "qd", "qdd"],
+            ),
         ];
         for (level, (what, values, inputs)) in rates.into_iter().enumerate() {
             let Some(values) = values else {
@@ -741,9 +758,10 @@ impl<'p> Kernels<'p> {
             );
             let call = kernel.call();
             let arm = quote! {
-                if let #some(out) = out.first_chunk_mut::<#n>() {
-                    #call;
-                }
+                let #some(out) = out.first_chunk_mut::<#n>() else {
+                    return;
+                };
+                #call;
             };
             [&mut self.velocity_rhs, &mut self.acceleration_rhs][level].push(
                 s,
@@ -763,10 +781,10 @@ impl<'p> Kernels<'p> {
             self.factor.push(
                 s,
                 quote! {
-                    match values.first_chunk_mut::<#slots>() {
-                        #some(values) => Self::#factor(values, tiny, limit),
-                        ::core::option::Option::None => ::core::result::Result::Err(0),
-                    }
+                    let #some(values) = values.first_chunk_mut::<#slots>() else {
+                        return ::core::result::Result::Err(0);
+                    };
+                    Self::#factor(values, tiny, limit)
                 },
                 &["values", "tiny", "limit"],
             );
@@ -777,11 +795,12 @@ impl<'p> Kernels<'p> {
                 dispatch.push(
                     s,
                     quote! {
-                        if let (#some(values), #some(x)) =
+                        let (#some(values), #some(x)) =
                             (values.first_chunk::<#slots>(), x.first_chunk_mut::<#n>())
-                        {
-                            Self::#function(values, x);
-                        }
+                        else {
+                            return;
+                        };
+                        Self::#function(values, x);
                     },
                     &["values", "x"],
                 );
@@ -855,9 +874,11 @@ fn lu_functions(cx: &Context<'_>, k: usize, f: &Factorization) -> [TokenStream; 
                 return ::core::result::Result::Err(#k_lit);
             }
         });
+        // The pivot's reciprocal replaces it: one division per pivot here, none in the solves.
+        factor.push(quote! { #pivot = 1.0 / #pivot; });
         for &(_, l) in &s.lower {
             let l = v(l);
-            factor.push(quote! { #l /= #pivot; });
+            factor.push(quote! { #l *= #pivot; });
         }
         if !s.lower.is_empty() {
             let checks = s.lower.iter().map(|&(_, l)| {
@@ -888,7 +909,7 @@ fn lu_functions(cx: &Context<'_>, k: usize, f: &Factorization) -> [TokenStream; 
     }
     for (step_k, s) in f.steps.iter().enumerate().rev() {
         let (xk, pivot) = (x(step_k), v(s.pivot));
-        solve.push(quote! { #xk /= #pivot; });
+        solve.push(quote! { #xk *= #pivot; });
         for &(i, u) in &f.upper_columns[step_k] {
             let (xi, u) = (x(i), v(u));
             solve.push(quote! { #xi -= #u * #xk; });
@@ -902,7 +923,7 @@ fn lu_functions(cx: &Context<'_>, k: usize, f: &Factorization) -> [TokenStream; 
             transpose.push(quote! { #xk -= #u * #xi; });
         }
         let pivot = v(s.pivot);
-        transpose.push(quote! { #xk /= #pivot; });
+        transpose.push(quote! { #xk *= #pivot; });
     }
     for (step_k, s) in f.steps.iter().enumerate().rev() {
         let xk = x(step_k);
@@ -919,16 +940,18 @@ fn lu_functions(cx: &Context<'_>, k: usize, f: &Factorization) -> [TokenStream; 
     };
     let summary = [
         format!(
-            " Static LU {k}: {n} × {n}, {} entries, {} fill-in, {} updates.",
+            " Static LU {k}: {n} × {n}, {} entries, {} fill-in, {} update{}.",
             f.entries,
             f.fill(),
             f.updates(),
+            if f.updates() == 1 { "" } else { "s" },
             n = f.n
         ),
         String::new(),
-        " Pivots on the diagonal in the block's order, each above `tiny`, its multipliers at most"
+        " Pivots on the diagonal in the block's order, each above `tiny` (then stored as its"
             .to_owned(),
-        " `limit`; returns the first step that fails.".to_owned(),
+        " reciprocal), its multipliers at most `limit`; returns the first step that fails."
+            .to_owned(),
     ];
     let factor_name = format_ident!("factor_{}", k);
     let factor = split(
@@ -979,8 +1002,11 @@ fn split(
     let max = cx.options.max_function_size.max(1);
     let result = fallible.then(|| quote!(-> ::core::result::Result<(), usize>));
     let ok = fallible.then(|| quote!(::core::result::Result::Ok(())));
+    // The factor's tests read `!(|pivot| > tiny)`, `!(|l| <= limit)`: NaN fails them.
+    let allow = fallible.then(|| quote!(#[allow(clippy::neg_cmp_op_on_partial_ord)]));
     if statements.len() <= max {
         return quote! {
+            #allow
             fn #name(#params) #result {
                 #(#statements)*
                 #ok
@@ -996,6 +1022,7 @@ fn split(
         parts.push(quote! {
             #[inline(never)]
             #[allow(unused_variables)]
+            #allow
             fn #part(#params) #result {
                 #(#chunk)*
                 #ok
