@@ -2,7 +2,7 @@
 //! [`Interpreted`] adapter that runs `.mech` scenes through the runtime's solver.
 //!
 //! The binary is a thin wrapper around [`run`]; the pieces are public so that tests and reports
-//! can reuse them (notably [`solve::sample_time`], the CLI's exact sample times).
+//! can reuse them. Sample times come from [`mechgen_runtime::sample_time`], as in the examples.
 
 pub mod args;
 pub mod diagnostics;

@@ -9,8 +9,9 @@
 //! ([`Structured`]): explicit assignments and small Newton blocks in dependency order, each
 //! block's sparse factorisation fixed at generation time. [`Solver`] solves one instant
 //! ([`Solver::solve`]); [`Simulation`] steps through time with a warm-started predictor;
-//! [`Dense`] solves any mechanism as one dense block (the reference). Failures are [`SolveError`]s; [`SolveError::describe`] names the
-//! equations and coordinates involved. [`State::write_csv_row`] writes results without a heap.
+//! [`Dense`] solves any mechanism as one dense block (the reference). Failures are
+//! [`SolveError`]s; [`Solver::describe`] names the equations and coordinates involved.
+//! [`State::write_csv_row`] writes results without a heap.
 #![no_std]
 // The runtime must build without std or alloc: catch `std::` paths that `core::` provides.
 #![warn(clippy::std_instead_of_core, clippy::alloc_instead_of_core)]
@@ -42,7 +43,7 @@ pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use mechanism::{
     Accelerations, Matrix, Mechanism, Outputs, ParameterError, Storage, Unit, Vector, Velocities,
 };
-pub use simulate::{Simulation, sample_time};
+pub use simulate::{DEFAULT_MAX_HALVINGS, Simulation, sample_time};
 pub use solver::{Convergence, Solver, SolverOptions};
 pub use state::{BodyState, Pose, PoseVelocity, State, write_csv_header};
 pub use structure::{Block, Pattern, Stage, Structured};

@@ -145,7 +145,8 @@ where
     /// branch flip) or lands suspiciously far from the prediction (the mirror branch), the
     /// drivers are sub-stepped: the interval is halved, and halved again on failure, down to
     /// 2^-`max_halvings` of it, each sub-step predicted from the last. The state then records the
-    /// sub-steps taken ([`State::substeps`]) and all their Newton iterations and fallbacks.
+    /// sub-steps taken ([`State::substeps`]) and all their Newton iterations, evaluations and
+    /// fallbacks.
     ///
     /// # Errors
     /// The [`SolveError`] of the solve at `t`, or of the sub-step that could not be shortened
@@ -176,7 +177,8 @@ where
         let t_start = self.saved.t;
         let shortest = (t_end - t_start).abs() / (1_u64 << self.max_halvings) as f64;
         let mut h = 0.5 * (t_end - t_start);
-        let (mut substeps, mut iterations, mut fallbacks, mut successes) = (0, 0, 0, 0);
+        let (mut substeps, mut iterations, mut successes) = (0, 0, 0);
+        let (mut evaluations, mut fallbacks) = (0, 0);
         loop {
             let reached = self.states[self.newest].t;
             let remaining = t_end - reached;
@@ -184,6 +186,7 @@ where
                 let current = &mut self.states[self.newest];
                 current.substeps = substeps;
                 current.iterations = iterations;
+                current.evaluations = evaluations;
                 current.fallbacks = fallbacks;
                 return Ok(current);
             }
@@ -200,6 +203,7 @@ where
                 Outcome::Solved => {
                     let current = &self.states[self.newest];
                     (substeps, iterations) = (substeps + 1, iterations + current.iterations);
+                    evaluations += current.evaluations;
                     fallbacks += current.fallbacks;
                     successes += 1;
                     // Two good sub-steps in a row: try a longer one (never beyond half the step).

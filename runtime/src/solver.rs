@@ -18,10 +18,10 @@ use crate::workspace::{Parts, Workspace};
 /// Tolerances and safeguards of the solve.
 ///
 /// Tolerances apply to the unit-scaled system (see [`crate::Unit`]): lengths are measured in
-/// units of the scene's [`Mechanism::length_scale`], angles in radians, and both relative to
-/// `max(1, ‖D_c⁻¹ q_b‖∞)` over the coordinates of the block being solved (so a coupler that has
-/// turned a million radians is still resolved to round-off). The same options then suit a
-/// micro-mechanism in metres and an engine in millimetres.
+/// units of the scene's [`crate::Mechanism::length_scale`], angles in radians, and both
+/// relative to `max(1, ‖D_c⁻¹ q_b‖∞)` over the coordinates of the block being solved (so a
+/// coupler that has turned a million radians is still resolved to round-off). The same options
+/// then suit a micro-mechanism in metres and an engine in millimetres.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverOptions {
     /// A first Newton correction ends the iteration only from a point whose scaled residual
@@ -292,6 +292,7 @@ where
         state.t = t;
         state.iterations = convergence.iterations;
         state.condition = convergence.condition;
+        state.evaluations = convergence.evaluations;
         state.fallbacks = convergence.fallbacks;
         Ok(())
     }

@@ -25,8 +25,13 @@ where
     pub(crate) velocities: Vector<M::Dim>,
     /// Accelerations q̈ (zero unless the scene computes them).
     pub(crate) accelerations: Vector<M::Dim>,
-    /// Newton updates the position solve needed (summed over sub-steps, if any).
+    /// Newton updates the position solve needed: the most any block needed (summed over
+    /// sub-steps, if any).
     pub iterations: usize,
+    /// Evaluations and factorisations of block Jacobians, summed over the blocks (and
+    /// sub-steps): one per Newton update, plus one at the solution for a block whose last
+    /// correction was not of round-off size (see [`crate::Convergence::evaluations`]).
+    pub evaluations: usize,
     /// Time steps this state took: 1, or more when [`crate::Simulation`] had to sub-step the
     /// drivers to get here (0 for a state not reached by stepping).
     pub substeps: usize,
@@ -120,6 +125,7 @@ where
             iterations: 0,
             substeps: 0,
             condition: f64::NAN,
+            evaluations: 0,
             fallbacks: 0,
             outputs: mechanism.outputs(),
             mechanism: PhantomData,
@@ -135,6 +141,7 @@ where
         self.iterations = other.iterations;
         self.substeps = other.substeps;
         self.condition = other.condition;
+        self.evaluations = other.evaluations;
         self.fallbacks = other.fallbacks;
     }
 
@@ -269,6 +276,7 @@ where
             iterations: self.iterations,
             substeps: self.substeps,
             condition: self.condition,
+            evaluations: self.evaluations,
             fallbacks: self.fallbacks,
             outputs: self.outputs,
             mechanism: PhantomData,
@@ -289,6 +297,7 @@ where
             .field("iterations", &self.iterations)
             .field("substeps", &self.substeps)
             .field("condition", &self.condition)
+            .field("evaluations", &self.evaluations)
             .field("fallbacks", &self.fallbacks)
             .field("outputs", &self.outputs)
             .finish()

@@ -8,7 +8,7 @@
 
 /// Storage the solver borrows for one solve. Implemented by [`Buffers`] (inline arrays, for
 /// generated scenes), [`crate::DenseBuffers`] (the dense reference) and, with the `alloc`
-/// feature, [`VecBuffers`] (the interpreter); the solver is its only user.
+/// feature, `VecBuffers` (the interpreter); the solver is its only user.
 pub trait Workspace {
     /// Every buffer at once, as disjoint slices.
     fn parts(&mut self) -> Parts<'_>;

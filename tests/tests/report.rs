@@ -70,8 +70,16 @@ fn quick_report_writes_files_consistent_with_the_closed_form() {
             );
             assert!(m.seconds_per_step.is_finite() && m.seconds_per_step > 0.0);
             assert!(
-                m.iterations >= 1.0,
+                m.work.iterations >= 1.0,
                 "every step applies at least one update"
+            );
+            // One factorisation per update per block, at most one more at the solution.
+            assert!(
+                m.work.evaluations >= m.work.iterations,
+                "{} {:?}: {:?}",
+                scene.slug,
+                point.method,
+                m.work
             );
         }
         // Exact Jacobians reach round-off at the tight (reference) tolerance.

@@ -175,7 +175,7 @@ fn range_text(labels: impl Iterator<Item = String>) -> String {
 fn points_csv(report: &Report) -> String {
     let mut s = String::from(
         "scene,method,tolerance,steps_per_revolution,predictor,error,error_q,error_qd,error_qdd,\
-         seconds_per_step,newton_iterations_per_step,timed_runs,failure\n",
+         seconds_per_step,newton_iterations_per_step,evaluations_per_step,timed_runs,failure\n",
     );
     for scene in &report.scenes {
         for point in &scene.points {
@@ -192,17 +192,18 @@ fn points_csv(report: &Report) -> String {
             let _ = match &point.outcome {
                 Ok(m) => writeln!(
                     s,
-                    "{:e},{:e},{:e},{:e},{:e},{},{},",
+                    "{:e},{:e},{:e},{:e},{:e},{},{},{},",
                     m.errors.max(),
                     m.errors.q,
                     m.errors.qd,
                     m.errors.qdd,
                     m.seconds_per_step,
-                    m.iterations,
+                    m.work.iterations,
+                    m.work.evaluations,
                     m.repetitions
                 ),
                 // Quotes doubled so that any message stays one CSV field.
-                Err(e) => writeln!(s, ",,,,,,,\"{}\"", e.replace('"', "\"\"")),
+                Err(e) => writeln!(s, ",,,,,,,,\"{}\"", e.replace('"', "\"\"")),
             };
         }
     }
@@ -247,18 +248,18 @@ fn reference_table(s: &mut String, scene: &SceneReport) {
     let _ = writeln!(
         s,
         "| method | max error | q | q̇ | q̈ | µs/step | × generated | Newton it./step | \
-         Φ, Φ_q evaluation | factorisation | solves | ν, γ |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+         factorisations/step | evaluation | factorisation | solves | rates |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for method in Method::ALL {
         let Some(m) = scene.at_reference(method) else {
-            let _ = writeln!(s, "| {} | failed | | | | | | | | | | |", method.label());
+            let _ = writeln!(s, "| {} | failed | | | | | | | | | | | |", method.label());
             continue;
         };
         let ratio = base.map_or("—".into(), |b| format!("{:.2}", m.seconds_per_step / b));
         let _ = write!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {:.2} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.2} |",
             method.label(),
             sci(Some(m.errors.max())),
             sci(Some(m.errors.q)),
@@ -266,7 +267,8 @@ fn reference_table(s: &mut String, scene: &SceneReport) {
             sci(Some(m.errors.qdd)),
             micros(Some(m.seconds_per_step)),
             ratio,
-            m.iterations
+            m.work.iterations,
+            m.work.evaluations
         );
         match scene.split(method) {
             Some(split) => {
@@ -307,9 +309,10 @@ fn pair(estimate: Option<criterion::Estimate>, format: fn(Option<f64>) -> String
 fn micro_table(s: &mut String, scene: &SceneReport, criterion_dir: &Path) {
     let _ = writeln!(
         s,
-        "| method | Φ+Φ_q (ns) | criterion Φ+Φ_q (ns): fastest / median | factorisation (ns) | \
-         solve (ns) | ν+γ (ns) | step (µs) | criterion step (µs): fastest / median |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|"
+        "| method | Φ+Φ_q (ns) | criterion Φ+Φ_q (ns): fastest / median | block evaluation (ns) | \
+         factorisation (ns) | solve (ns) | rates (ns) | step (µs) | \
+         criterion step (µs): fastest / median |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for method in Method::ALL {
         let micro = scene.micro(method);
@@ -317,10 +320,11 @@ fn micro_table(s: &mut String, scene: &SceneReport, criterion_dir: &Path) {
         let bench = |function: &str| criterion::read(criterion_dir, &group, function);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             method.label(),
             nanos(micro.map(|m| m.phi_and_jacobian)),
             pair(bench("phi_and_jacobian"), nanos),
+            nanos(micro.map(|m| m.evaluation)),
             nanos(micro.map(|m| m.factorisation)),
             nanos(micro.map(|m| m.solve)),
             nanos(micro.map(|m| m.rates)),
@@ -361,7 +365,7 @@ fn all_points_table(s: &mut String, scene: &SceneReport) {
                     sci(Some(m.errors.qd)),
                     sci(Some(m.errors.qdd)),
                     micros(Some(m.seconds_per_step)),
-                    m.iterations,
+                    m.work.iterations,
                     m.repetitions
                 );
             }
@@ -393,8 +397,10 @@ fn markdown(report: &Report, criterion_dir: &Path) -> String {
     );
     s.push_str(
         "All methods solve the same equations with the same runtime solver (`Solver`, \
-         `Simulation`: Newton–Raphson, the same LU, the same stepping and predictor); they differ \
-         only in how Φ_q is obtained, and the interpreter also in how everything is evaluated:\n\n",
+         `Simulation`: Newton–Raphson, the same stopping rule, stepping and predictor); they \
+         differ in how the solve is structured (the scene's plan of explicit assignments and \
+         small blocks, or one dense block), in how Φ_q is obtained, and for the interpreter in \
+         how everything is evaluated:\n\n",
     );
     for method in Method::ALL {
         let _ = writeln!(s, "- **{}**: {}", method.label(), method.description());
@@ -461,7 +467,7 @@ fn markdown(report: &Report, criterion_dir: &Path) -> String {
                         method.label(),
                         sci(Some(m.errors.max())),
                         micros(Some(m.seconds_per_step)),
-                        m.iterations
+                        m.work.iterations
                     );
                 }
                 None => {
@@ -485,20 +491,29 @@ fn markdown(report: &Report, criterion_dir: &Path) -> String {
          a long run. The timed runs go in passes over all points of a scene, so each \
          point's runs are spread over the whole sweep and a slow spell of the machine hits \
          every method alike. Errors are not computed in timed runs.\n\
-         - **Newton iterations per step**: updates per step averaged over the revolution. A step \
-         with k updates evaluates and factors Φ_q k + 1 times (the last confirms convergence and \
-         its factors serve the velocity and acceleration solves) and solves k + 2 times.\n\
+         - **Newton iterations per step**: updates per step averaged over the revolution (the \
+         most any block needed). **Factorisations per step**: evaluations and factorisations of \
+         block Jacobians, summed over the blocks: one per update, and one more at the solution \
+         unless the last correction was of round-off size (its factors then serve the velocity \
+         and acceleration solves).\n\
          - **Time split**: not instrumented inside the loop (a clock read costs as much as a \
          generated Φ). Each piece is timed on its own at one solved state, in {} rounds of one \
          batch of ~{} ms, one round per pass of the timed runs (the fastest round kept, so \
          the pieces and the steps they split are measured over the same stretch of time), and \
-         multiplied by the per-step counts above: Φ and Φ_q (`phi_and_jacobian`); factorisation = copying \
-         this method's Φ_q into the LU's storage and factoring it, minus the copy alone; solve = \
-         one substitution, minus the copy restoring its right-hand side; ν, γ = one evaluation \
-         of each. The table shows each piece's share of the pieces' sum: timed in isolation, \
-         the pieces need not add up to the measured step (the predictor, norms, finiteness \
-         checks and copies are left out; warm, isolated batches can also run faster or slower \
-         than inside a step), so the shares, not the remainder, are what the split tells.\n\
+         multiplied by the per-step counts above. For the methods solved through the scene's \
+         structure (generated, interpreter): evaluation = the block kernels (Φ_b and the \
+         block's Jacobian values) and explicit assignments, factorisation = copying the \
+         blocks' values and running their static LUs minus the copy alone, solve = one \
+         substitution per block, each averaged per block; rates = every stage's velocity and \
+         acceleration kernels. For the dense methods: Φ and Φ_q (`phi_and_jacobian`), \
+         copying this method's Φ_q into the LU's storage and factoring it (minus the copy \
+         alone), one substitution (minus the copy restoring its right-hand side), ν and γ. \
+         Evaluations and factorisations count the factorisations per step, solves about one \
+         per factorisation plus two per block. The table shows each piece's share of the \
+         pieces' sum: timed in isolation, the pieces need not add up to the measured step \
+         (the predictor, norms, the condition estimate, finiteness checks and copies are left \
+         out; warm, isolated batches can also run faster or slower than inside a step), so the \
+         shares, not the remainder, are what the split tells.\n\
          - **Machine**: on a shared or virtual machine the speed can change in spells lasting \
          seconds; absolute times then move between runs by tens of percent, while the ratios \
          between methods, measured side by side, move by a few percent.\n\

@@ -30,7 +30,7 @@ use crate::closed_form::{self, Kinematics};
 use crate::scenes::{FourBar, PistonCrank};
 
 pub use methods::{AutoDiff, CentralDifference, ForwardDifference, Method, MethodError};
-pub use sweep::{Measured, Plan, Point, Setting, Timing};
+pub use sweep::{Measured, Plan, Point, Setting, Timing, Work};
 pub use timing::{Micro, Split};
 
 /// Command-line options of the report.
@@ -196,7 +196,7 @@ impl SceneReport {
         let micro = self.micro(method)?;
         Some(Split::of_step(
             micro,
-            measured.iterations,
+            measured.work,
             measured.seconds_per_step,
         ))
     }
@@ -248,7 +248,7 @@ impl Report {
                             m.errors.max(),
                             m.seconds_per_step * 1e6,
                             ratio,
-                            m.iterations
+                            m.work.iterations
                         );
                     }
                     None => {
@@ -415,7 +415,7 @@ where
     struct Run {
         method: Method,
         setting: Setting,
-        accuracy: Result<(RelativeErrors, f64), SolveError>,
+        accuracy: Result<(RelativeErrors, Work), SolveError>,
         timing: Timing,
         failure: Option<SolveError>,
     }
@@ -491,12 +491,12 @@ where
         .map(|run| {
             let outcome = run
                 .accuracy
-                .and_then(|(errors, iterations)| match run.failure {
+                .and_then(|(errors, work)| match run.failure {
                     Some(error) => Err(error),
                     None => Ok(Measured {
                         errors,
                         seconds_per_step: run.timing.seconds_per_step(),
-                        iterations,
+                        work,
                         repetitions: run.timing.repetitions,
                     }),
                 })
@@ -527,7 +527,7 @@ trait RunSetting<const N: usize> {
         setting: Setting,
         period: f64,
         exact: &dyn Fn(f64) -> Kinematics<N>,
-    ) -> Result<(RelativeErrors, f64), SolveError>;
+    ) -> Result<(RelativeErrors, Work), SolveError>;
 
     fn time_once(
         &self,
@@ -549,7 +549,7 @@ where
         setting: Setting,
         period: f64,
         exact: &dyn Fn(f64) -> Kinematics<N>,
-    ) -> Result<(RelativeErrors, f64), SolveError> {
+    ) -> Result<(RelativeErrors, Work), SolveError> {
         sweep::accuracy(self, setting, period, exact)
     }
 

@@ -5,7 +5,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use mechgen_runtime::{
-    Accelerations, Simulation, SolveError, Solver, SolverOptions, Structured, Vector, sample_time,
+    Accelerations, Simulation, SolveError, Solver, SolverOptions, State, Structured, sample_time,
 };
 
 use crate::accuracy::{ErrorTracker, RelativeErrors};
@@ -153,10 +153,20 @@ pub struct Measured {
     pub errors: RelativeErrors,
     /// Wall time per step, seconds ([`Timing::seconds_per_step`]).
     pub seconds_per_step: f64,
-    /// Mean Newton updates per step (assembly excluded).
-    pub iterations: f64,
+    /// Mean work per step.
+    pub work: Work,
     /// Timed runs.
     pub repetitions: usize,
+}
+
+/// Mean solver work per step of a run (assembly excluded).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Work {
+    /// Newton updates ([`mechgen_runtime::State::iterations`]).
+    pub iterations: f64,
+    /// Block Jacobian evaluations and factorisations, summed over the blocks
+    /// ([`mechgen_runtime::State::evaluations`]).
+    pub evaluations: f64,
 }
 
 /// One point of the sweep: a method at a setting, and what happened.
@@ -171,7 +181,7 @@ pub struct Point {
 }
 
 /// The accuracy half of a point: one run over the revolution, every state compared with the
-/// closed form. Returns the errors and the mean Newton updates per step (assembly excluded).
+/// closed form. Returns the errors and the mean work per step (assembly excluded).
 ///
 /// # Errors
 /// The first [`SolveError`] (with its time).
@@ -180,14 +190,14 @@ pub fn accuracy<M, const N: usize>(
     setting: Setting,
     period: f64,
     exact: &dyn Fn(f64) -> Kinematics<N>,
-) -> Result<(RelativeErrors, f64), SolveError>
+) -> Result<(RelativeErrors, Work), SolveError>
 where
     M: Structured + Accelerations + Clone,
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
 {
     let mut simulation = start(mechanism, setting)?;
     let mut tracker = ErrorTracker::new();
-    let (mut iterations, mut first) = (0usize, true);
+    let (mut iterations, mut evaluations, mut first) = (0usize, 0usize, true);
     simulation.run(period, setting.steps, |state| {
         tracker.add(
             state.q.as_slice(),
@@ -198,12 +208,17 @@ where
         // The first visit is the assembly from the declared guess, not a step.
         if !first {
             iterations += state.iterations;
+            evaluations += state.evaluations;
         }
         first = false;
     })?;
+    let steps = setting.steps.max(1) as f64;
     Ok((
         tracker.errors(),
-        iterations as f64 / setting.steps.max(1) as f64,
+        Work {
+            iterations: iterations as f64 / steps,
+            evaluations: evaluations as f64 / steps,
+        },
     ))
 }
 
@@ -304,7 +319,7 @@ where
     M: Structured + Accelerations + Clone,
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
 {
-    let (errors, iterations) = accuracy(mechanism, setting, period, exact)?;
+    let (errors, work) = accuracy(mechanism, setting, period, exact)?;
     let mut timing = Timing::new(setting.steps);
     while timing.wants_more(plan) {
         timing.run(mechanism, setting, period)?;
@@ -312,7 +327,7 @@ where
     Ok(Measured {
         errors,
         seconds_per_step: timing.seconds_per_step(),
-        iterations,
+        work,
         repetitions: timing.repetitions,
     })
 }
@@ -328,16 +343,19 @@ where
     M: Structured + Accelerations + Clone,
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
 {
-    let (q, t) = state_at(mechanism, 0.1 * period, plan.reference.options())?;
-    Ok(timing::measure(mechanism, &q, t, plan.micro_batch, 1))
+    let state = state_at(mechanism, 0.1 * period, plan.reference.options())?;
+    Ok(timing::measure(
+        mechanism,
+        &state.q,
+        state.qd(),
+        state.t,
+        plan.micro_batch,
+        1,
+    ))
 }
 
 /// Assembles `mechanism` and solves it at `t`.
-fn state_at<M>(
-    mechanism: &M,
-    t: f64,
-    options: SolverOptions,
-) -> Result<(Vector<M::Dim>, f64), SolveError>
+fn state_at<M>(mechanism: &M, t: f64, options: SolverOptions) -> Result<State<M>, SolveError>
 where
     M: Structured + Accelerations + Clone,
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
@@ -345,7 +363,7 @@ where
     let solver = Solver::with_options(mechanism.clone(), options);
     let mut simulation = Simulation::new(solver, 0.0)?;
     let state = simulation.step_to(t)?;
-    Ok((state.q.clone(), state.t))
+    Ok(state.clone())
 }
 
 #[cfg(test)]

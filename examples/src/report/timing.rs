@@ -1,6 +1,7 @@
-//! Micro-timing for the report: the cost of one call of the pieces a step is made of (Φ and Φ_q,
-//! factorisation, a triangular solve, ν and γ), measured in batches, and the split of a step's
-//! time among them.
+//! Micro-timing for the report: the cost of one call of the pieces a step is made of (a block's
+//! evaluation, its factorisation, a triangular solve, the rate kernels; for a dense method Φ
+//! and Φ_q, the dense LU, ν and γ), measured in batches, and the split of a step's time among
+//! them.
 //!
 //! Batches rather than a clock read per call: `Instant::now` costs ~20 ns, as much as a
 //! generated Φ. Each figure is the best of a few batches (the least disturbed by the rest of
@@ -10,7 +11,9 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use mechgen_runtime::nalgebra::{DefaultAllocator, U1};
-use mechgen_runtime::{Accelerations, Lu, Matrix, Storage, Vector};
+use mechgen_runtime::{Accelerations, Block, Lu, Matrix, Stage, Storage, Structured, Vector};
+
+use super::sweep::Work;
 
 /// Seconds per call of `f`: calibrates a batch size lasting about `batch`, then keeps the best
 /// of `batches` batches.
@@ -52,15 +55,22 @@ pub fn seconds_per_call(batch: Duration, batches: usize, mut f: impl FnMut()) ->
 /// Cost of one call of each piece of a step, seconds.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Micro {
-    /// Φ and Φ_q together (`phi_and_jacobian`, what each Newton iteration evaluates).
+    /// Φ and Φ_q together through the textbook function (`phi_and_jacobian`), as the criterion
+    /// benchmarks time it.
     pub phi_and_jacobian: f64,
-    /// One LU factorisation of this method's Φ_q (copy into the LU's storage and factor, minus
-    /// the copy alone).
+    /// One evaluation as the solver makes it: one block's Φ_b and Jacobian values (averaged
+    /// over the scene's blocks, explicit assignments included); for a dense method, Φ and Φ_q.
+    pub evaluation: f64,
+    /// One factorisation of a block's Jacobian (averaged over the blocks; for a dense method,
+    /// copying its Φ_q into the LU's storage and factoring it, minus the copy alone).
     pub factorisation: f64,
-    /// One forward/back substitution with the factors.
+    /// One forward/back substitution with a block's factors (averaged over the blocks).
     pub solve: f64,
-    /// ν and γ, one evaluation each.
+    /// The rate kernels of one step: ν and γ for a dense method; every stage's velocity and
+    /// acceleration kernels for a structured one.
     pub rates: f64,
+    /// Newton blocks of the method's solve.
+    pub blocks: usize,
 }
 
 impl Micro {
@@ -68,17 +78,20 @@ impl Micro {
     pub fn fastest(&self, other: &Micro) -> Micro {
         Micro {
             phi_and_jacobian: self.phi_and_jacobian.min(other.phi_and_jacobian),
+            evaluation: self.evaluation.min(other.evaluation),
             factorisation: self.factorisation.min(other.factorisation),
             solve: self.solve.min(other.solve),
             rates: self.rates.min(other.rates),
+            blocks: self.blocks,
         }
     }
 }
 
-/// Times the pieces of a step for `mechanism` at the solved positions `q` at time `t`.
-pub fn measure<M: Accelerations>(
+/// Times the pieces of a step for `mechanism` at the solved state (`q`, `qd`) at time `t`.
+pub fn measure<M: Structured + Accelerations>(
     mechanism: &M,
     q: &Vector<M::Dim>,
+    qd: &Vector<M::Dim>,
     t: f64,
     batch: Duration,
     batches: usize,
@@ -89,9 +102,136 @@ where
     let dim = mechanism.dim();
     let mut phi = Vector::zeros_generic(dim, U1);
     let mut jacobian = Matrix::zeros_generic(dim, dim);
-    let evaluation = seconds_per_call(batch, batches, || {
+    let phi_and_jacobian = seconds_per_call(batch, batches, || {
         mechanism.phi_and_jacobian(black_box(q), black_box(t), &mut phi, &mut jacobian);
         black_box(&jacobian);
+    });
+    let blocks: Vec<(usize, Block<'_>)> = (0..mechanism.stage_count())
+        .filter_map(|s| match mechanism.stage(s)? {
+            Stage::Block(block) => Some((s, block)),
+            Stage::Explicit { .. } => None,
+        })
+        .collect();
+    let pieces = if blocks.iter().all(|(_, b)| b.static_pivots) {
+        structured(mechanism, &blocks, q, qd, t, batch, batches)
+    } else {
+        dense(mechanism, &jacobian, q, t, batch, batches)
+    };
+    Micro {
+        phi_and_jacobian,
+        blocks: blocks.len().max(1),
+        ..pieces
+    }
+}
+
+/// The pieces of a scene solved through its structure: every block's kernels at the solved
+/// state, summed, then averaged per block.
+fn structured<M: Structured + Accelerations>(
+    m: &M,
+    blocks: &[(usize, Block<'_>)],
+    q: &Vector<M::Dim>,
+    qd: &Vector<M::Dim>,
+    t: f64,
+    batch: Duration,
+    batches: usize,
+) -> Micro
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let stages = m.stage_count();
+    // Each cached angle takes two slots: twice the coordinates is always enough.
+    let mut trig = vec![0.0; 2 * q.len()];
+    for s in 0..stages {
+        m.fill_trig(s, q, &mut trig);
+    }
+    let slots = blocks.iter().map(|(_, b)| b.slots).max().unwrap_or(0);
+    let size = blocks.iter().map(|(_, b)| b.len()).max().unwrap_or(0);
+    let (mut values, mut phi) = (vec![0.0; slots], vec![0.0; size]);
+    let mut q_assigned = q.clone();
+    let evaluation = seconds_per_call(batch, batches, || {
+        for s in 0..stages {
+            m.assign_positions(s, &mut q_assigned, &trig, t);
+        }
+        for &(s, b) in blocks {
+            m.block_jacobian(s, black_box(q), &trig, t, &mut phi[..b.len()], &mut values);
+        }
+        black_box((&q_assigned, &values));
+    });
+    // Every block's Jacobian values, kept, and the factors of each (a block that fails its
+    // static pivots here is factored as far as it goes: the figure is then small, not wrong
+    // by a panic).
+    let jacobians: Vec<Vec<f64>> = blocks
+        .iter()
+        .map(|&(s, b)| {
+            m.block_jacobian(s, q, &trig, t, &mut phi[..b.len()], &mut values);
+            values[..b.slots].to_vec()
+        })
+        .collect();
+    let mut factors = jacobians.clone();
+    let copy_and_factor = |factors: &mut [Vec<f64>]| {
+        for (&(s, b), (f, j)) in blocks.iter().zip(factors.iter_mut().zip(&jacobians)) {
+            f.copy_from_slice(j);
+            let _ = black_box(m.factor(s, &mut f[..b.slots], 0.0, f64::INFINITY));
+        }
+    };
+    let copy_and_factorisation = seconds_per_call(batch, batches, || copy_and_factor(&mut factors));
+    let copy = seconds_per_call(batch, batches, || {
+        for (f, j) in factors.iter_mut().zip(&jacobians) {
+            f.copy_from_slice(black_box(j));
+        }
+        black_box(&factors);
+    });
+    copy_and_factor(&mut factors);
+    let mut x = vec![1.0; size];
+    let solve = seconds_per_call(batch, batches, || {
+        for (&(s, b), f) in blocks.iter().zip(&factors) {
+            x.fill(1.0);
+            m.solve(s, f, &mut x[..b.len()]);
+        }
+        black_box(&x);
+    });
+    let (mut qd_assigned, mut qdd) = (qd.clone(), qd.clone());
+    let rates = seconds_per_call(batch, batches, || {
+        for s in 0..stages {
+            m.assign_velocities(s, q, &trig, &mut qd_assigned, t);
+            m.assign_accelerations(s, q, &trig, qd, &mut qdd, t);
+        }
+        for &(s, b) in blocks {
+            m.velocity_rhs(s, q, &trig, qd, t, &mut phi[..b.len()]);
+            m.acceleration_rhs(s, q, &trig, qd, &qdd, t, &mut phi[..b.len()]);
+        }
+        black_box((&qd_assigned, &qdd, &phi));
+    });
+    let per_block = 1.0 / blocks.len().max(1) as f64;
+    Micro {
+        phi_and_jacobian: 0.0,
+        evaluation: evaluation * per_block,
+        factorisation: (copy_and_factorisation - copy).max(0.0) * per_block,
+        solve: solve * per_block,
+        rates,
+        blocks: blocks.len(),
+    }
+}
+
+/// The pieces of a dense solve: Φ and Φ_q from the textbook function, factored and solved
+/// with partial pivoting.
+fn dense<M: Accelerations>(
+    mechanism: &M,
+    jacobian: &Matrix<M::Dim>,
+    q: &Vector<M::Dim>,
+    t: f64,
+    batch: Duration,
+    batches: usize,
+) -> Micro
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let dim = mechanism.dim();
+    let mut phi = Vector::zeros_generic(dim, U1);
+    let mut scratch = jacobian.clone();
+    let evaluation = seconds_per_call(batch, batches, || {
+        mechanism.phi_and_jacobian(black_box(q), black_box(t), &mut phi, &mut scratch);
+        black_box(&scratch);
     });
 
     // Factor this method's own Φ_q (its zeros, which the LU skips, are this method's), copied
@@ -100,17 +240,16 @@ where
     // noise of slow evaluations.)
     let mut lu = Lu::new(dim);
     let copy_and_factorisation = seconds_per_call(batch, batches, || {
-        let factored = lu.factor_with(|storage| storage.copy_from(black_box(&jacobian)));
+        let factored = lu.factor_with(|storage| storage.copy_from(black_box(jacobian)));
         let _ = black_box(factored);
     });
-    let mut scratch = jacobian.clone();
     let matrix_copy = seconds_per_call(batch, batches, || {
-        scratch.copy_from(black_box(&jacobian));
+        scratch.copy_from(black_box(jacobian));
         black_box(&scratch);
     });
     // Leave `lu` holding the factors at q for the solves below (a failure leaves it unfactored
     // and the solves then return at once: the figures are small, not wrong by a panic).
-    let _ = lu.factor(&jacobian);
+    let _ = lu.factor(jacobian);
 
     let mut rhs = Vector::zeros_generic(dim, U1);
     rhs.fill(1.0);
@@ -141,37 +280,39 @@ where
 
     Micro {
         phi_and_jacobian: evaluation,
+        evaluation,
         factorisation: (copy_and_factorisation - matrix_copy).max(0.0),
         solve: (solve - copy).max(0.0),
         rates,
+        blocks: 1,
     }
 }
 
 /// Where a step's time goes, seconds per step.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Split {
-    /// (iterations + 1) evaluations of Φ and Φ_q.
+    /// The step's block evaluations.
     pub evaluation: f64,
-    /// (iterations + 1) factorisations.
+    /// As many factorisations.
     pub factorisation: f64,
-    /// (iterations + 2) substitutions: one per Newton update, one each for q̇ and q̈.
+    /// Substitutions: about one per evaluation (Newton updates), and two per block (q̇, q̈).
     pub solves: f64,
-    /// One evaluation each of ν and γ.
+    /// One pass of the rate kernels.
     pub rates: f64,
-    /// The measured step time minus the above: predictor, norms, checks, copies (negative
-    /// when the isolated figures overestimate the pieces in the loop).
+    /// The measured step time minus the above: predictor, norms, condition estimate, checks,
+    /// copies (negative when the isolated figures overestimate the pieces in the loop).
     pub rest: f64,
 }
 
 impl Split {
-    /// Splits a measured step of `seconds_per_step` with `iterations` Newton updates on average,
-    /// following what `Solver::solve_into` does: each update evaluates and factors Φ_q and
-    /// solves once; convergence is confirmed by one more evaluation and factorisation at the
-    /// returned positions, whose factors then serve the velocity and acceleration solves.
-    pub fn of_step(micro: &Micro, iterations: f64, seconds_per_step: f64) -> Self {
-        let evaluation = (iterations + 1.0) * micro.phi_and_jacobian;
-        let factorisation = (iterations + 1.0) * micro.factorisation;
-        let solves = (iterations + 2.0) * micro.solve;
+    /// Splits a measured step of `seconds_per_step` that did `work` on average, following what
+    /// `Solver::solve_into` does: each evaluation of a block is factored, each Newton update
+    /// solves once, and each block's velocities and accelerations are one solve each with the
+    /// factors it ends with.
+    pub fn of_step(micro: &Micro, work: Work, seconds_per_step: f64) -> Self {
+        let evaluation = work.evaluations * micro.evaluation;
+        let factorisation = work.evaluations * micro.factorisation;
+        let solves = (work.evaluations + 2.0 * micro.blocks as f64) * micro.solve;
         let rates = micro.rates;
         Split {
             evaluation,
@@ -191,16 +332,22 @@ mod tests {
     fn split_follows_the_step_structure() {
         let micro = Micro {
             phi_and_jacobian: 1.0,
+            evaluation: 1.0,
             factorisation: 2.0,
             solve: 0.5,
             rates: 0.25,
+            blocks: 1,
         };
-        let split = Split::of_step(&micro, 2.0, 20.0);
-        assert_eq!(split.evaluation, 3.0);
-        assert_eq!(split.factorisation, 6.0);
+        let work = Work {
+            iterations: 2.0,
+            evaluations: 2.0,
+        };
+        let split = Split::of_step(&micro, work, 20.0);
+        assert_eq!(split.evaluation, 2.0);
+        assert_eq!(split.factorisation, 4.0);
         assert_eq!(split.solves, 2.0);
         assert_eq!(split.rates, 0.25);
-        assert_eq!(split.rest, 20.0 - 11.25);
+        assert_eq!(split.rest, 20.0 - 8.25);
     }
 
     #[test]
