@@ -7,7 +7,7 @@
 //! one solver implementation of `mechgen-runtime` with scenes read from `.mech` files, and it
 //! agrees with generated code to the bit.
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 
 use mechgen::Scene;
 use mechgen::factor::Factorization;
@@ -54,6 +54,8 @@ pub struct Interpreted {
     largest: (usize, usize, usize),
     /// Tape slots and output values, reused by every call (evaluation is `&self`).
     scratch: RefCell<Scratch>,
+    /// Block Jacobian evaluations so far: the unit of a solve's work, which fuzzing bounds.
+    evaluations: Cell<u64>,
 }
 
 /// One stage of the plan, with its tapes.
@@ -75,6 +77,8 @@ enum PlanStage {
         /// Residuals, then Jacobian values.
         jacobian: Tape,
         factorization: Option<Factorization>,
+        /// The slot of each static pivot (empty without a factorisation).
+        pivots: Vec<usize>,
         velocity_rhs: Option<Tape>,
         acceleration_rhs: Option<Tape>,
         trig: Option<(Tape, Vec<usize>)>,
@@ -131,6 +135,11 @@ impl PlanStage {
                     slots: block.slots(),
                     jacobian: tape(&roots, Phase::Positions),
                     factorization: block.factorization.clone(),
+                    pivots: block
+                        .factorization
+                        .iter()
+                        .flat_map(|f| f.steps.iter().map(|step| step.pivot))
+                        .collect(),
                     velocity_rhs: block.velocity_rhs.as_deref().map(|v| tape(v, Phase::After)),
                     acceleration_rhs: block
                         .acceleration_rhs
@@ -182,6 +191,12 @@ struct Scratch {
 }
 
 impl Interpreted {
+    /// Block Jacobian evaluations (each with its residual) made since the scene was built: the
+    /// work of every solve, whatever its outcome, counted without a clock.
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations.get()
+    }
+
     /// Builds the interpreter for a compiled scene (parameters start at their defaults).
     pub fn new(scene: &Scene) -> Self {
         let (model, kin) = (&scene.model, &scene.kinematics);
@@ -268,6 +283,7 @@ impl Interpreted {
             stages,
             reads: plan.reads.clone(),
             largest: (plan.largest_block(), plan.largest_slots(), plan.trig.len()),
+            evaluations: Cell::new(0),
             scratch: RefCell::new(Scratch {
                 slots: vec![0.0; slots],
                 values: vec![0.0; values],
@@ -526,14 +542,14 @@ impl Structured for Interpreted {
                 coordinates,
                 pattern,
                 slots,
-                factorization,
+                pivots,
                 ..
             } => Stage::Block(Block {
                 equations,
                 coordinates,
                 pattern: Pattern::Sparse(pattern),
                 slots: *slots,
-                static_pivots: factorization.is_some(),
+                pivots,
                 reads,
             }),
         })
@@ -584,6 +600,7 @@ impl Structured for Interpreted {
         phi: &mut [f64],
         values: &mut [f64],
     ) {
+        self.evaluations.set(self.evaluations.get() + 1);
         if let Some(PlanStage::Block {
             jacobian, pattern, ..
         }) = self.stages.get(stage)

@@ -114,6 +114,10 @@ fn assembly_hint(error: &SolveError) -> &'static str {
             "the guesses lead to another assembly branch than the scene's `branch` declares: \
              move the `near` guesses towards the declared branch"
         }
+        SolveError::Unresolved { .. } => {
+            "a coordinate is too large to resolve: give `near` angles within a turn and \
+             positions near the scene's size, and check parameters that set huge values"
+        }
         _ => "check the parameter values and the `near` guesses for divisions by zero",
     }
 }
@@ -135,6 +139,10 @@ fn step_hint(error: &SolveError) -> &'static str {
         SolveError::BranchFlip { .. } => {
             "the motion would leave the declared assembly branch (through a singular position, \
              or the steps are too coarse even after sub-stepping): try more `--steps`"
+        }
+        SolveError::Unresolved { .. } => {
+            "a coordinate has grown too large to resolve (a driven angle after very many \
+             turns?): start the run at a smaller time, or drive the angle with a periodic law"
         }
         _ => "a value became NaN or infinite: check the parameter values and the time range",
     }

@@ -15,6 +15,7 @@ use crate::graph::{self, UNMATCHED};
 use crate::model::{
     Body, Branch, Constraint, ConstraintKind, Driven, Model, Outputs, Param, Point,
 };
+use crate::resolution::{self, Lengths};
 use crate::spec::{BinOp, BranchDecl, DriverKind, Expr, ExprKind, JointKind, PointRef, Spec};
 
 /// Checks a spec and builds its model.
@@ -40,6 +41,7 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
         params: HashMap::new(),
         prismatic: HashMap::new(),
         ground: Vec::new(),
+        lengths: Lengths::default(),
     };
     cx.check_names(spec);
     let outputs = cx.outputs(spec);
@@ -62,7 +64,16 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
             name: b.name.clone(),
             docs: b.docs.clone(),
             ground: b.ground,
-            pose: [0, 1, 2].map(|k| cx.geometry(&b.pose[k])),
+            pose: {
+                // A ground body's position is scene geometry; a guess is only a start.
+                let [x, y, angle] = &b.pose;
+                let (x, y) = if b.ground {
+                    (cx.length(x), cx.length(y))
+                } else {
+                    (cx.geometry(x), cx.geometry(y))
+                };
+                [x, y, cx.angle(angle)]
+            },
         })
         .collect();
 
@@ -119,6 +130,7 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
         let structure = Structure::of_model(&mut model);
         cx.check_mobility(spec, &model, &structure);
     }
+    cx.lengths.check(&mut cx.errors);
     cx.errors.finish()?;
     Ok(model)
 }
@@ -131,6 +143,8 @@ struct Checker {
     /// Prismatic joints by name, for `travel` drivers: (a, b, unit axis).
     prismatic: HashMap<String, (Point, Point, [Id; 2])>,
     ground: Vec<bool>,
+    /// Constant lengths, for the range and resolution rules.
+    lengths: Lengths,
 }
 
 impl Checker {
@@ -211,6 +225,48 @@ impl Checker {
         Outputs::ALL[names.len().clamp(1, 3) - 1]
     }
 
+    /// Names every moving body that no joint joins and no driver moves: it floats freely, and
+    /// the degree-of-freedom count would blame the drivers for it. Returns whether there is one.
+    fn check_floating(&mut self, spec: &Spec) -> bool {
+        let joined = |body: &Ident| {
+            spec.joints.iter().any(|j| match &j.kind {
+                JointKind::Revolute { a, b }
+                | JointKind::Prismatic { a, b, .. }
+                | JointKind::Distance { a, b, .. } => a.body == *body || b.body == *body,
+            })
+        };
+        let driven = |body: &Ident| {
+            spec.drivers.iter().any(|d| match &d.kind {
+                DriverKind::Angle(b) => b == body,
+                DriverKind::RelativeAngle(a, b) => a == body || b == body,
+                DriverKind::X(p) | DriverKind::Y(p) => p.body == *body,
+                DriverKind::Travel(_) => false,
+            })
+        };
+        let anchor = spec
+            .bodies
+            .iter()
+            .find(|b| b.ground)
+            .map_or_else(|| "OTHER".to_owned(), |b| b.name.to_string());
+        let mut floating = false;
+        for body in spec.bodies.iter().filter(|b| !b.ground) {
+            if joined(&body.name) || driven(&body.name) {
+                continue;
+            }
+            floating = true;
+            self.errors.push(
+                body.name.span(),
+                format!(
+                    "body `{0}` is not connected: no joint joins it and no driver moves it, so \
+                     its three coordinates are free; connect it, e.g. `joint {0}_pin: \
+                     revolute({0}, {anchor} @ (x, y));`, or remove it",
+                    body.name
+                ),
+            );
+        }
+        floating
+    }
+
     fn body(&mut self, name: &Ident) -> Option<usize> {
         let found = self.bodies.get(&name.to_string()).copied();
         if found.is_none() {
@@ -242,7 +298,7 @@ impl Checker {
     fn point(&mut self, p: &PointRef) -> Option<Point> {
         let body = self.body(&p.body)?;
         let local = match &p.local {
-            Some(xy) => [self.geometry(&xy[0]), self.geometry(&xy[1])],
+            Some(xy) => [self.length(&xy[0]), self.length(&xy[1])],
             None => [self.arena.zero(), self.arena.zero()],
         };
         Some(Point { body, local })
@@ -307,14 +363,28 @@ impl Checker {
             }
             JointKind::Distance { a, b, length } => {
                 let points = self.two_points(a, b);
-                let value = self.geometry(length);
-                if self.arena.as_const(value) == Some(0.0) {
-                    self.errors.push(
-                        length.span,
-                        "a distance of zero makes the constraint degenerate (its Jacobian \
-                         vanishes); use `revolute` to make two points coincide",
-                    );
-                    return None;
+                let value = self.length(length);
+                match self.arena.as_const(value) {
+                    Some(0.0) => {
+                        self.errors.push(
+                            length.span,
+                            "a distance of zero makes the constraint degenerate (its Jacobian \
+                             vanishes); use `revolute` to make two points coincide",
+                        );
+                        return None;
+                    }
+                    Some(negative) if negative < 0.0 => {
+                        self.errors.push(
+                            length.span,
+                            format!(
+                                "a distance is a length between two points and cannot be \
+                                 negative; write {}",
+                                -negative
+                            ),
+                        );
+                        return None;
+                    }
+                    _ => {}
                 }
                 let (a, b) = points?;
                 Some(ConstraintKind::Distance {
@@ -461,6 +531,10 @@ impl Checker {
     /// structurally non-singular ([`Structure`]): no group of constraints may over-determine
     /// some bodies while others keep free coordinates.
     fn check_mobility(&mut self, spec: &Spec, model: &Model, structure: &Structure) {
+        if self.check_floating(spec) {
+            // A count would only blame the drivers for a body nothing holds.
+            return;
+        }
         let moving = spec.bodies.iter().filter(|b| !b.ground).count();
         let joint_equations: usize = spec
             .joints
@@ -507,11 +581,28 @@ impl Checker {
                 .iter()
                 .find(|b| !b.ground)
                 .map_or_else(|| "BODY".to_owned(), |b| b.name.to_string());
+            let taken = |name: &str| {
+                let params = spec.params.iter().map(|p| &p.name);
+                let joints = spec.joints.iter().map(|j| &j.name);
+                let drivers = spec.drivers.iter().map(|d| &d.name);
+                self.bodies.contains_key(name)
+                    || params.chain(joints).chain(drivers).any(|n| n == name)
+            };
+            let spin = (1..)
+                .map(|k| {
+                    if k == 1 {
+                        "spin".to_owned()
+                    } else {
+                        format!("spin{k}")
+                    }
+                })
+                .find(|name| !taken(name))
+                .unwrap_or_default();
             self.errors.push(
                 spec.name.span(),
                 format!(
                     "`{}` has {dof} degree{} of freedom but {drivers} driver{} ({count}); add \
-                     {missing} driver{}, e.g. `driver spin: angle({example}) = t;`",
+                     {missing} driver{}, e.g. `driver {spin}: angle({example}) = t;`",
                     spec.name,
                     plural(dof),
                     plural(drivers),
@@ -606,6 +697,38 @@ impl Checker {
         self.lower_with(e, true, false)
     }
 
+    /// A length of the scene's geometry: a constant one is recorded for the range and
+    /// resolution rules ([`resolution`]).
+    fn length(&mut self, e: &Expr) -> Id {
+        let id = self.geometry(e);
+        if let Some(value) = self.arena.as_const(id) {
+            self.lengths.record(value, e.span);
+        }
+        id
+    }
+
+    /// An angle that only enters through its sine and cosine (a pose, a guess): a constant one
+    /// beyond a half turn is reduced to (−π, π].
+    fn angle(&mut self, e: &Expr) -> Id {
+        let id = self.geometry(e);
+        match self.arena.as_const(id) {
+            Some(value) => self.arena.constant(resolution::reduce_angle(value)),
+            None => id,
+        }
+    }
+
+    /// Reports a constant expression that folded to NaN or infinity (the arena keeps such a
+    /// node unfolded): `result` computed from constant `operands` must be a constant.
+    fn check_folded(&mut self, span: Span, result: Id, operands: &[Id], hint: &str) {
+        let constant = |id: &Id| self.arena.as_const(*id).is_some();
+        if operands.iter().all(constant) && !constant(&result) {
+            self.errors.push(
+                span,
+                format!("this constant expression is NaN or infinite: {hint}"),
+            );
+        }
+    }
+
     /// A driver's value: parameters and time allowed.
     fn lower(&mut self, e: &Expr, allow_t: bool) -> Id {
         self.lower_with(e, true, allow_t)
@@ -664,26 +787,46 @@ impl Checker {
             ExprKind::Binary(op, a, b) => {
                 let a = self.lower_with(a, allow_params, allow_t);
                 let b = self.lower_with(b, allow_params, allow_t);
-                match op {
+                let result = match op {
                     BinOp::Add => self.arena.add(a, b),
                     BinOp::Sub => self.arena.sub(a, b),
                     BinOp::Mul => self.arena.mul(a, b),
                     BinOp::Div => {
                         if self.arena.as_const(b) == Some(0.0) {
                             self.errors.push(e.span, "division by zero");
+                            return self.arena.div(a, b);
                         }
                         self.arena.div(a, b)
                     }
-                }
+                };
+                self.check_folded(e.span, result, &[a, b], "the result overflows an f64");
+                result
             }
             ExprKind::Pow(a, n) => {
                 let a = self.lower_with(a, allow_params, allow_t);
-                self.arena.powi(a, *n)
+                let result = self.arena.powi(a, *n);
+                self.check_folded(
+                    e.span,
+                    result,
+                    &[a],
+                    "the power overflows an f64, or is a negative power of zero",
+                );
+                result
             }
             ExprKind::Call(f, a) => {
                 let arg = self.lower_with(a, allow_params, allow_t);
                 match Func::from_name(&f.to_string()) {
-                    Some(func) => self.arena.call(func, arg),
+                    Some(func) => {
+                        let result = self.arena.call(func, arg);
+                        let hint = match func {
+                            Func::Sqrt => "`sqrt` needs an argument ≥ 0",
+                            Func::Ln => "`ln` needs a positive argument",
+                            Func::Tan => "`tan` is infinite at odd multiples of π/2",
+                            _ => "the result overflows an f64",
+                        };
+                        self.check_folded(e.span, result, &[arg], hint);
+                        result
+                    }
                     None => {
                         let names: Vec<String> = Func::ALL
                             .iter()

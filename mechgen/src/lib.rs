@@ -26,6 +26,7 @@ pub mod kinematics;
 pub mod limits;
 pub mod model;
 pub mod parse;
+pub mod resolution;
 pub mod spec;
 pub mod stats;
 pub mod structure;

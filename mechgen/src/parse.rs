@@ -320,7 +320,18 @@ fn joint_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, JointKind)>
         }
     };
     if !args.is_empty() {
-        return Err(args.error("unexpected argument"));
+        let advice = match joint {
+            JointKind::Revolute { .. } => {
+                "`revolute` joins two points: `revolute(a @ (x, y), b @ (x, y))`"
+            }
+            JointKind::Prismatic { .. } => {
+                "`prismatic` takes two bodies and an axis: `prismatic(a, b, along (ux, uy))`"
+            }
+            JointKind::Distance { .. } => {
+                "`distance` takes two points and a length: `distance(a @ (x, y), b, length)`"
+            }
+        };
+        return Err(args.error(format!("unexpected argument: {advice}")));
     }
     Ok((kind.span(), joint))
 }
@@ -351,7 +362,22 @@ fn driver_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, DriverKind
         }
     };
     if !args.is_empty() {
-        return Err(args.error("unexpected argument"));
+        let advice = match driver {
+            DriverKind::Angle(_) => {
+                "`angle` drives one body's absolute angle; to drive the angle between two \
+                 bodies, write `relative_angle(a, b)`"
+            }
+            DriverKind::X(_) | DriverKind::Y(_) => {
+                "`x` and `y` drive one point's global coordinate: `x(body @ (px, py))`"
+            }
+            DriverKind::Travel(_) => {
+                "`travel` takes the name of one prismatic joint: `travel(slide)`"
+            }
+            DriverKind::RelativeAngle(..) => {
+                "`relative_angle` takes two bodies: `relative_angle(a, b)`"
+            }
+        };
+        return Err(args.error(format!("unexpected argument: {advice}")));
     }
     Ok((kind.span(), driver))
 }
@@ -491,7 +517,15 @@ fn atom(input: ParseStream) -> syn::Result<Expr> {
             parenthesized!(content in input);
             let arg: Expr = content.parse()?;
             if !content.is_empty() {
-                return Err(content.error("functions take one argument"));
+                let supported: Vec<String> = crate::expr::Func::ALL
+                    .iter()
+                    .map(|f| format!("`{}`", f.name()))
+                    .collect();
+                return Err(content.error(format!(
+                    "`{name}` with more than one argument is not supported: the functions are \
+                     {}, each of one argument",
+                    supported.join(", ")
+                )));
             }
             return Ok(Expr {
                 span,

@@ -163,7 +163,7 @@ where
     ) -> Result<Factors, LuError> {
         let (n, slots) = (self.n(), self.block.slots);
         let (largest, norm1) = self.evaluate(q, trig, t, phi, storage.values, scales, sums)?;
-        let fallback = self.block.static_pivots && options.static_pivots;
+        let fallback = !self.block.pivots.is_empty() && options.static_pivots;
         if fallback {
             // The same singularity test as partial pivoting, plus the threshold on multipliers.
             let tiny = options.pivot_tolerance * n as f64 * largest.max(SCALE_FLOOR);
@@ -242,6 +242,24 @@ where
             }
             Factors::Dense { .. } => {
                 lu::solve_transposed_factors(&storage.lu[..n * n], &storage.swaps[..n], x);
+            }
+        }
+    }
+
+    /// The sign of det S (+1 or −1) from its factors: with the static order, the product of
+    /// the pivots' signs (stored as reciprocals in [`Block::pivots`], no permutation); with
+    /// partial pivoting, [`lu::determinant_sign`]. Both are in the block's local order, and the
+    /// scalings are positive, so the sign changes only where the block Jacobian is singular.
+    pub fn orientation(&self, factors: Factors, storage: &FactorStorage<'_>) -> f64 {
+        let n = self.n();
+        match factors {
+            Factors::Static { .. } => self
+                .block
+                .pivots
+                .iter()
+                .fold(1.0, |sign, &slot| sign * storage.values[slot].signum()),
+            Factors::Dense { .. } => {
+                lu::determinant_sign(&storage.lu[..n * n], &storage.swaps[..n])
             }
         }
     }

@@ -188,7 +188,7 @@ where
                 coordinates: self.indices.as_slice(),
                 pattern: Pattern::Dense,
                 slots: n * n,
-                static_pivots: false,
+                pivots: &[],
                 reads: &[],
             })
         })

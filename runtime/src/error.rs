@@ -97,6 +97,20 @@ pub enum SolveError {
         /// The equation with the largest scaled residual there.
         equation: usize,
     },
+    /// Newton's corrections reached the rounding of the coordinates, but the residual stayed
+    /// above [`crate::SolverOptions::acceptance_tolerance`]: a coordinate too large to resolve
+    /// in double precision (an angle of 1e12 rad, whose rounding alone is 1e-4 rad, or a
+    /// position far beyond the scene's size).
+    Unresolved {
+        /// Time of the solve.
+        time: f64,
+        /// Newton updates applied.
+        iterations: usize,
+        /// ‖Φ‖∞ of the block at the returned positions.
+        residual: f64,
+        /// The equation with the largest scaled residual.
+        equation: usize,
+    },
     /// Φ_q is singular or too ill-conditioned to trust at the solution: a toggle (dead-point)
     /// position, or redundant constraints.
     ///
@@ -155,6 +169,7 @@ impl SolveError {
         match *self {
             Self::NoConvergence { time, .. }
             | Self::NoAssembly { time, .. }
+            | Self::Unresolved { time, .. }
             | Self::Singular { time, .. }
             | Self::BranchFlip { time, .. }
             | Self::NonFinite { time, .. } => Some(time),
@@ -213,6 +228,26 @@ impl SolveError {
                 )?;
                 equation(f, index)?;
                 f.write_str("; check the link lengths and the driver values (can the loop close?)")
+            }
+            Self::Unresolved {
+                time,
+                iterations,
+                residual,
+                equation: index,
+            } => {
+                write!(
+                    f,
+                    "the positions at t = {time} cannot be resolved in double precision: after \
+                     {iterations} iterations the corrections reached the rounding of the \
+                     coordinates, but ‖Φ‖∞ = {residual:e} remains, largest in equation "
+                )?;
+                equation(f, index)?;
+                f.write_str(
+                    "; a coordinate is too large for its rounding to satisfy the constraints \
+                     (an angle of many turns in a guess or a driver, or a position far outside \
+                     the scene): reduce angles modulo 2π and keep the coordinates near the \
+                     scene's size",
+                )
             }
             Self::Singular {
                 time,
@@ -303,7 +338,9 @@ where
                 names.equation = m.equation_name(equation);
                 names.coordinate = m.coordinate_name(coordinate);
             }
-            SolveError::NoAssembly { equation, .. } => names.equation = m.equation_name(equation),
+            SolveError::NoAssembly { equation, .. } | SolveError::Unresolved { equation, .. } => {
+                names.equation = m.equation_name(equation);
+            }
             SolveError::BranchFlip { branch, .. } => names.branch = m.branch_name(branch),
             SolveError::NonFinite {
                 quantity: Quantity::Parameter(index),

@@ -23,6 +23,7 @@ extern crate alloc;
 extern crate std;
 
 mod block;
+mod crossing;
 mod dense;
 mod error;
 mod lu;

@@ -661,6 +661,17 @@ fn scale_slice(x: &mut [f64], scale: &[f64]) {
     }
 }
 
+/// The sign of det S (+1 or −1) from the packed factors of `P S = L U` (non-singular): the
+/// signs of U's diagonal times that of the row swaps. Positive scalings leave it unchanged, so
+/// it is the sign of the block Jacobian's determinant in the block's local order.
+pub(crate) fn determinant_sign(a: &[f64], swaps: &[usize]) -> f64 {
+    let n = swaps.len();
+    swaps.iter().enumerate().fold(1.0, |sign, (k, &swap)| {
+        let flip = if swap == k { 1.0 } else { -1.0 };
+        sign * flip * a[k * n + k].signum()
+    })
+}
+
 /// Solves `S y = x` in place with the packed factors `a` (n × n, column-major) of `P S = L U`.
 ///
 /// The caller guarantees `a.len() == n²` and `swaps.len() == n == x.len()`, `swaps[k] < n`.
@@ -956,6 +967,25 @@ mod tests {
         let mut b = Vector3::new(5.0, 10.5, 14.0);
         factored(m).solve_in_place(&mut b).unwrap();
         assert!((b - Vector3::new(1.5, 2.0, 3.0)).amax() < 1e-15);
+    }
+
+    #[test]
+    fn determinant_sign_counts_pivot_signs_and_row_swaps() {
+        // Column-major 3 × 3 matrices with known determinants, factored in place.
+        let cases: [([f64; 9], f64); 3] = [
+            ([2.0, 1.0, 0.0, 1.0, 3.0, 1.0, 0.0, 1.0, 4.0], 1.0), // det 18
+            ([0.0, 0.0, 4.0, 1.0, 0.0, 0.0, 0.0, 2.0, 0.0], 1.0), // det 8, two swaps
+            ([0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, -3.0], 1.0), // det 3, one swap, U₂₂ < 0
+        ];
+        for (mut a, expected) in cases {
+            let mut swaps = [0; 3];
+            factor_in_place(&mut a, &mut swaps, 1e-13, 0.0).unwrap();
+            assert_eq!(determinant_sign(&a, &swaps), expected);
+        }
+        let mut a = [0.0, 1.0, 1.0, 0.0]; // [[0, 1], [1, 0]]: det −1
+        let mut swaps = [0; 2];
+        factor_in_place(&mut a, &mut swaps, 1e-13, 0.0).unwrap();
+        assert_eq!(determinant_sign(&a, &swaps), -1.0);
     }
 
     #[test]

@@ -57,6 +57,10 @@ const CRAWL_LIMIT: usize = 3;
 /// A last correction this small (scaled) moved the Jacobian by less than its own rounding: its
 /// factors serve the derivative solves at the returned positions.
 pub(crate) const NEGLIGIBLE_STEP: f64 = 8.0 * f64::EPSILON;
+/// Levenberg–Marquardt damping values tried for one step before the residual counts as a
+/// minimum: μ grows fourfold per trial from at least 1e-12 of the largest column norm to at
+/// most 1e14 of it, which takes at most 43 trials; the cap only guards that arithmetic.
+const MAX_DAMPING_TRIALS: usize = 64;
 
 /// Levenberg–Marquardt state carried across the iterations of one block's solve.
 #[derive(Default)]
@@ -79,6 +83,12 @@ pub(crate) struct Solved {
     pub residual: f64,
     /// Condition estimate κ₁ of the scaled block Jacobian (NaN if switched off).
     pub condition: f64,
+    /// The sign of the block Jacobian's determinant (local order) at the returned positions.
+    pub orientation: f64,
+    /// Whether the iterates' Jacobians had both determinant signs: Newton crossed a singular
+    /// configuration on its way (from a prediction past a toggle onto the branch that meets
+    /// the starting one there, say), so the solution may not continue the starting branch.
+    pub swept: bool,
     /// The factors at the returned positions.
     pub factors: Factors,
 }
@@ -93,12 +103,32 @@ pub(crate) struct Newton<'a, 'w, M> {
     pub fallbacks: usize,
     /// Evaluations (and factorisations) of the block's Jacobian.
     pub evaluations: usize,
+    /// Determinant signs of the factorisations so far: (a positive one, a negative one).
+    signs: (bool, bool),
 }
 
-impl<M: Structured> Newton<'_, '_, M>
+impl<'a, 'w, M: Structured> Newton<'a, 'w, M>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
+    /// The solve of one block at time `t`.
+    pub fn new(
+        bs: BlockSolve<'a, M>,
+        parts: &'a mut Parts<'w>,
+        options: &'a SolverOptions,
+        t: f64,
+    ) -> Self {
+        Self {
+            bs,
+            parts,
+            options,
+            t,
+            fallbacks: 0,
+            evaluations: 0,
+            signs: (false, false),
+        }
+    }
+
     /// Newton–Raphson on the block's equations, from and into the block's coordinates of `q`
     /// (earlier stages' coordinates are inputs), ending with the block's factors at the
     /// returned positions when `factors_needed` (derivative solves follow).
@@ -107,13 +137,17 @@ where
     /// [`SolveError::NonFinite`] for a non-finite Φ, Φ_q or step; [`SolveError::Singular`] at a
     /// solution where the block Jacobian is singular or too ill-conditioned (the diagnosis is
     /// in the workspace's orders); [`SolveError::NoAssembly`] when the residual stops
-    /// decreasing above the tolerance; [`SolveError::NoConvergence`] after `max_iterations`.
+    /// decreasing above the tolerance; [`SolveError::Unresolved`] when the corrections reached
+    /// the rounding of the coordinates but the residual stayed above `acceptance_tolerance`;
+    /// [`SolveError::NoConvergence`] after `max_iterations`.
     pub fn solve(
         &mut self,
         q: &mut Vector<M::Dim>,
         factors_needed: bool,
     ) -> Result<Solved, SolveError> {
         let options = *self.options;
+        // A looser residual tolerance asked for loosens acceptance with it.
+        let acceptance = options.acceptance_tolerance.max(options.residual_tolerance);
         let (mut iterations, mut finishing) = (0, false);
         // Length of the last full Newton correction, for the contraction test, and how many
         // corrections in a row crawled.
@@ -129,6 +163,11 @@ where
             let magnitude = self.magnitude(q);
             let small = residual <= options.residual_tolerance * magnitude;
             if finishing {
+                // Acceptance is absolute: a step test relative to large coordinates (an angle
+                // of 1e12 rad) must not accept a residual of their rounding.
+                if residual > acceptance {
+                    return Err(self.unresolved(iterations));
+                }
                 return match factored {
                     Ok(factors) => self.finish(q, factors, iterations),
                     Err(error) => Err(self.factor_error(q, error)),
@@ -198,7 +237,10 @@ where
             pending = Some((merit, fraction));
             iterations += 1;
             if converged {
-                if !factors_needed || length <= NEGLIGIBLE_STEP {
+                // The residual before the correction bounds the one after it; only when it is
+                // above the acceptance tolerance must the returned positions be evaluated.
+                let accepted = residual <= acceptance;
+                if accepted && (!factors_needed || length <= NEGLIGIBLE_STEP) {
                     return self.finish(q, factors, iterations);
                 }
                 finishing = true;
@@ -220,8 +262,13 @@ where
             self.options,
         );
         self.evaluations += 1;
-        if factored.is_ok_and(Factors::fell_back) {
-            self.fallbacks += 1;
+        if let Ok(factors) = factored {
+            self.fallbacks += usize::from(factors.fell_back());
+            if self.bs.orientation(factors, &self.parts.factors) > 0.0 {
+                self.signs.0 = true;
+            } else {
+                self.signs.1 = true;
+            }
         }
         factored
     }
@@ -316,6 +363,8 @@ where
             iterations,
             residual: max_abs(&self.parts.newton.phi[..self.bs.n()]),
             condition,
+            orientation: self.bs.orientation(factors, &self.parts.factors),
+            swept: self.signs.0 && self.signs.1,
             factors,
         })
     }
@@ -376,6 +425,29 @@ where
             };
             return self.diagnose(q, condition);
         }
+        let (equation, residual) = self.worst_equation();
+        SolveError::NoAssembly {
+            time: self.t,
+            iterations,
+            residual,
+            equation,
+        }
+    }
+
+    /// Converged as finely as the coordinates' rounding allows, with the residual in `phi`
+    /// still above the acceptance tolerance.
+    fn unresolved(&self, iterations: usize) -> SolveError {
+        let (equation, residual) = self.worst_equation();
+        SolveError::Unresolved {
+            time: self.t,
+            iterations,
+            residual,
+            equation,
+        }
+    }
+
+    /// The global index of the equation with the largest scaled residual in `phi`, and ‖Φ_b‖∞.
+    fn worst_equation(&self) -> (usize, f64) {
         let n = self.bs.n();
         let (rows, phi) = (&self.parts.scales.rows[..n], &self.parts.newton.phi[..n]);
         let mut worst = (0, 0.0);
@@ -384,12 +456,8 @@ where
                 worst = (i, (r * p).abs());
             }
         }
-        SolveError::NoAssembly {
-            time: self.t,
-            iterations,
-            residual: max_abs(phi),
-            equation: self.bs.block.equations.get(worst.0).copied().unwrap_or(0),
-        }
+        let equation = self.bs.block.equations.get(worst.0).copied().unwrap_or(0);
+        (equation, max_abs(phi))
     }
 
     /// The rank-revealing diagnosis of a singular or ill-conditioned block Jacobian at `q`:
@@ -485,6 +553,9 @@ where
             return Ok(());
         }
         let largest = self.gradient();
+        if !largest.is_finite() {
+            return Err(non_finite(self.t, Quantity::Jacobian));
+        }
         if largest == 0.0 {
             // The Jacobian vanishes: no direction reduces the residual.
             return Err(self.no_assembly(q, *iterations));
@@ -495,7 +566,9 @@ where
         self.save_base(q);
         // μ beyond this leaves a step of round-off size: the residual is at a minimum.
         let mu_limit = 1e14 * largest;
-        while marquardt.mu <= mu_limit {
+        let mut trials = 0;
+        while marquardt.mu <= mu_limit && trials < MAX_DAMPING_TRIALS {
+            trials += 1;
             let mu = marquardt.mu;
             let parts = &mut *self.parts;
             let (lu, swaps) = (

@@ -1,5 +1,7 @@
 //! Stepping a mechanism through time: each Newton solve warm-started from a predictor, checked
-//! for a jump to another branch, and retried in sub-steps when it fails or jumps.
+//! for a jump to another branch, and retried in sub-steps when it fails or jumps; and every
+//! step checked for a singular configuration crossed between two solutions (see
+//! [`crate::crossing`]).
 
 use nalgebra::DefaultAllocator;
 
@@ -24,23 +26,25 @@ pub const DEFAULT_MAX_HALVINGS: u32 = 10;
 
 /// A solver plus the last solved state, advanced with [`Simulation::step_to`].
 ///
-/// Holds three states and alternates between two of them, so stepping never allocates (nor
-/// copies a state) and a failed step leaves the last good state untouched.
+/// Holds four states and alternates between two of them, so stepping never allocates (nor
+/// copies a state on the usual path) and a failed step leaves the last good state untouched.
 pub struct Simulation<M: Structured>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
-    solver: Solver<M>,
+    pub(crate) solver: Solver<M>,
     /// The current state, `states[newest]`, and the scratch for the next solve, which after a
     /// step holds the state before the current one.
-    states: [State<M>; 2],
-    newest: usize,
+    pub(crate) states: [State<M>; 2],
+    pub(crate) newest: usize,
     /// The state a sub-stepped step started from, restored if it fails.
     saved: State<M>,
+    /// The latest solution before a singular crossing, while the crossing is located.
+    pub(crate) bracket: State<M>,
     /// The last prediction, to measure how far Newton moved from it.
     prediction: Vector<M::Dim>,
     /// Whether `next` holds a solved earlier state (for the positions-only predictor).
-    has_previous: bool,
+    pub(crate) has_previous: bool,
     predictor: bool,
     max_halvings: u32,
 }
@@ -57,6 +61,7 @@ where
             states: self.states.clone(),
             newest: self.newest,
             saved: self.saved.clone(),
+            bracket: self.bracket.clone(),
             prediction: self.prediction.clone(),
             has_previous: self.has_previous,
             predictor: self.predictor,
@@ -70,6 +75,8 @@ enum Outcome {
     Solved,
     /// Converged, but far from the prediction: possibly on another branch.
     Jumped,
+    /// Converged with the other sign of det Φ_q: a singular configuration lies between.
+    Crossed,
     Failed(SolveError),
 }
 
@@ -88,6 +95,7 @@ where
         current.substeps = 1;
         Ok(Self {
             saved: current.clone(),
+            bracket: current.clone(),
             prediction: current.q.clone(),
             states: [current.clone(), current],
             newest: 0,
@@ -164,7 +172,13 @@ where
                 return Err(error);
             }
             Outcome::Jumped if self.max_halvings == 0 => self.accept(),
-            Outcome::Failed(_) | Outcome::Jumped => return self.substep(t),
+            Outcome::Crossed if self.max_halvings == 0 => {
+                self.locate_crossing(t)?;
+                self.accept();
+            }
+            // A coarse step may land on the mirror branch, whose determinant has the other
+            // sign: sub-step first, and locate a crossing that persists at the finest sub-step.
+            Outcome::Failed(_) | Outcome::Jumped | Outcome::Crossed => return self.substep(t),
         }
         let current = &mut self.states[self.newest];
         current.substeps = 1;
@@ -199,7 +213,26 @@ where
             // At the shortest sub-step a jump is accepted: continuation from the last state is
             // as close to the motion as stepping can get (declared branches are still checked).
             let finest = 0.5 * h.abs() < shortest;
-            match self.advance(target, finest) {
+            let mut outcome = self.advance(target, finest);
+            // At the finest sub-step the prediction is too close to jump: a change of
+            // determinant sign, or of a declared branch, is a crossing to locate.
+            let crossed = matches!(
+                outcome,
+                Outcome::Crossed | Outcome::Failed(SolveError::BranchFlip { .. })
+            );
+            if crossed && finest {
+                outcome = match self.locate_crossing(target) {
+                    Ok(()) => {
+                        self.accept();
+                        Outcome::Solved
+                    }
+                    Err(error) => {
+                        self.states[self.newest].copy_from(&self.saved);
+                        return Err(error);
+                    }
+                };
+            }
+            match outcome {
                 Outcome::Solved => {
                     let current = &self.states[self.newest];
                     (substeps, iterations) = (substeps + 1, iterations + current.iterations);
@@ -215,7 +248,9 @@ where
                     self.states[self.newest].copy_from(&self.saved);
                     return Err(error);
                 }
-                Outcome::Failed(_) | Outcome::Jumped => (h, successes) = (0.5 * h, 0),
+                Outcome::Failed(_) | Outcome::Jumped | Outcome::Crossed => {
+                    (h, successes) = (0.5 * h, 0);
+                }
             }
         }
     }
@@ -245,11 +280,15 @@ where
                 return Outcome::Jumped;
             }
         }
+        if next.orientation != current.orientation || next.swept {
+            return Outcome::Crossed;
+        }
         self.accept();
         Outcome::Solved
     }
 
-    fn accept(&mut self) {
+    /// Makes `next` the current state.
+    pub(crate) fn accept(&mut self) {
         self.newest = 1 - self.newest;
         self.has_previous = true;
     }
@@ -276,7 +315,7 @@ where
 }
 
 /// The state at `newest` and the other one.
-fn pair<T>(states: &mut [T; 2], newest: usize) -> (&T, &mut T) {
+pub(crate) fn pair<T>(states: &mut [T; 2], newest: usize) -> (&T, &mut T) {
     let [a, b] = states;
     if newest == 0 { (a, b) } else { (b, a) }
 }
@@ -287,7 +326,12 @@ fn pair<T>(states: &mut [T; 2], newest: usize) -> (&T, &mut T) {
 /// holds when `history` (the secant slope for positions-only scenes, q̈ from two velocities,
 /// the jerk from two accelerations). A positions-only scene without history has nothing to
 /// predict with.
-fn predict<M: Mechanism>(current: &State<M>, next: &mut State<M>, history: bool, t: f64) -> bool
+pub(crate) fn predict<M: Mechanism>(
+    current: &State<M>,
+    next: &mut State<M>,
+    history: bool,
+    t: f64,
+) -> bool
 where
     DefaultAllocator: Storage<M::Dim>,
 {

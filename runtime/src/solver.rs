@@ -31,6 +31,14 @@ pub struct SolverOptions {
     /// convergence is evident (see the `position` module: quadratic contraction, or a first
     /// correction from a point within `residual_tolerance`).
     pub step_tolerance: f64,
+    /// A solution is accepted only when its scaled residual ‖D_r Φ_b‖∞ is within this, in
+    /// scene lengths and radians, whatever the size of the coordinates (default 1e-8). The step
+    /// and residual tolerances above are relative to the coordinates' magnitude, so that a
+    /// crank that has turned for hours still converges; this absolute test is what keeps a
+    /// coordinate too large to resolve (an angle of 1e12 rad, whose rounding alone is 1e-4)
+    /// from being accepted: such a solve fails with [`SolveError::Unresolved`]. A looser
+    /// `residual_tolerance` (a work-precision sweep) loosens it to that.
+    pub acceptance_tolerance: f64,
     /// Updates (Newton, damped or Levenberg–Marquardt) per block before giving up (default 50).
     pub max_iterations: usize,
     /// Relative pivot tolerance τ of the scaled block Jacobians: a pivot counts as zero when
@@ -45,10 +53,14 @@ pub struct SolverOptions {
     /// with partial pivoting, and the fallback is counted ([`crate::State::fallbacks`]).
     pub static_pivot_threshold: f64,
     /// Largest condition estimate of a scaled block Jacobian accepted at a solution (default
-    /// 1e10).
+    /// 1e8).
     ///
-    /// Velocities and accelerations lose about log₁₀(κ) digits, so 1e10 still leaves six; above
-    /// it the solve fails with [`SolveError::Singular`] rather than return digits of noise.
+    /// Above it the solve fails with [`SolveError::Singular`]. Two reasons set the default.
+    /// Velocities and accelerations lose about log₁₀(κ) digits, so 1e8 still leaves eight.
+    /// And at a double root (a toggle position), Newton places the solution only about √ε
+    /// away, where κ is of order 1/√ε ≈ 7e7 times the scene's own constants (about 1e9 for a
+    /// slider-crank whose rod equals its crank). A limit above that would accept such a point,
+    /// with velocities halfway between the two branches that meet there.
     pub max_condition: f64,
     /// Largest scaled Newton step (default 1): a step is shortened to move no coordinate by
     /// more than this many scene lengths or radians, so a bad guess cannot throw the iterate
@@ -68,11 +80,12 @@ impl Default for SolverOptions {
         Self {
             residual_tolerance: 1e-10,
             step_tolerance: 1e-10,
+            acceptance_tolerance: 1e-8,
             max_iterations: 50,
             pivot_tolerance: DEFAULT_PIVOT_TOLERANCE,
             static_pivots: true,
             static_pivot_threshold: 0.1,
-            max_condition: 1e10,
+            max_condition: 1e8,
             max_step: 1.0,
             scale_units: true,
             estimate_condition: true,
@@ -99,6 +112,14 @@ pub struct Convergence {
     /// Newton iteration, plus one at the returned positions unless the last correction was of
     /// round-off size (its factors then serve the rates).
     pub evaluations: usize,
+    /// The sign of det Φ_q (unit-scaled, in the scene's solve order), +1 or −1: the product of
+    /// the blocks' determinant signs (fixed and explicit coordinates have constant
+    /// coefficients). It changes between two solutions only if Φ_q is singular somewhere
+    /// between them; [`crate::Simulation`] watches it to catch toggle crossings.
+    pub orientation: i8,
+    /// Whether a block's Newton iterates met both determinant signs: the iteration crossed
+    /// a singular configuration between its start and the solution.
+    pub swept: bool,
 }
 
 impl Convergence {
@@ -109,6 +130,8 @@ impl Convergence {
             condition: if estimate_condition { 1.0 } else { f64::NAN },
             fallbacks: 0,
             evaluations: 0,
+            orientation: 1,
+            swept: false,
         }
     }
 
@@ -124,6 +147,10 @@ impl Convergence {
         };
         self.fallbacks += fallbacks;
         self.evaluations += evaluations;
+        if block.orientation < 0.0 {
+            self.orientation = -self.orientation;
+        }
+        self.swept |= block.swept;
     }
 }
 
@@ -294,6 +321,8 @@ where
         state.condition = convergence.condition;
         state.evaluations = convergence.evaluations;
         state.fallbacks = convergence.fallbacks;
+        state.orientation = convergence.orientation;
+        state.swept = convergence.swept;
         Ok(())
     }
 
@@ -352,14 +381,7 @@ where
                 Some(Stage::Block(block)) => {
                     let bs = BlockSolve { m, stage: s, block };
                     bs.set_scales(&mut parts.scales, length);
-                    let mut newton = Newton {
-                        bs,
-                        parts: &mut parts,
-                        options,
-                        t,
-                        fallbacks: 0,
-                        evaluations: 0,
-                    };
+                    let mut newton = Newton::new(bs, &mut parts, options, t);
                     let solved = newton
                         .solve(q, rates != Rates::None)
                         .map_err(|e| record(e, m, s, newton.parts, diagnosed))?;
@@ -418,14 +440,7 @@ where
                 Some(Stage::Block(block)) => {
                     let bs = BlockSolve { m, stage: s, block };
                     bs.set_scales(&mut parts.scales, length);
-                    let mut newton = Newton {
-                        bs,
-                        parts: &mut parts,
-                        options,
-                        t,
-                        fallbacks: 0,
-                        evaluations: 0,
-                    };
+                    let mut newton = Newton::new(bs, &mut parts, options, t);
                     let factors = newton
                         .factor_at(q)
                         .map_err(|e| record(e, m, s, newton.parts, diagnosed))?;
@@ -436,6 +451,64 @@ where
             }
         }
         check_rates(qd, qdd, t, rates)
+    }
+
+    /// The diagnosis of the configuration `q` at `t` (a solution next to a singular one): every
+    /// block is factored there, and the one with the largest condition estimate gets the
+    /// rank-revealing diagnosis ([`SolveError::Singular`], with the lists behind
+    /// [`Solver::dependent_equations`]).
+    pub(crate) fn diagnose_at(&mut self, t: f64, q: &Vector<M::Dim>) -> SolveError {
+        self.update_scale();
+        self.diagnosed = (0, 0);
+        let Self {
+            mechanism: m,
+            options,
+            workspace,
+            length,
+            diagnosed,
+        } = self;
+        let mut parts = workspace.parts();
+        let mut worst: Option<(usize, f64)> = None;
+        for pass in 0..2 {
+            for s in 0..m.stage_count() {
+                let block = match m.stage(s) {
+                    Some(Stage::Explicit { .. }) => {
+                        m.fill_trig(s, q, parts.trig);
+                        continue;
+                    }
+                    Some(Stage::Block(block)) => block,
+                    None => break,
+                };
+                let bs = BlockSolve { m, stage: s, block };
+                bs.set_scales(&mut parts.scales, length);
+                let mut newton = Newton::new(bs, &mut parts, options, t);
+                // Second pass: the trig cache is complete; diagnose the worst block.
+                if pass == 1 {
+                    if worst.is_some_and(|(stage, _)| stage == s) {
+                        let condition = worst.map_or(f64::INFINITY, |(_, c)| c);
+                        let error = newton.diagnose(q, condition);
+                        return record(error, m, s, newton.parts, diagnosed);
+                    }
+                    continue;
+                }
+                let condition = match newton.factor_at(q) {
+                    Ok(factors) => newton.condition(factors),
+                    Err(error) => return record(error, m, s, newton.parts, diagnosed),
+                };
+                // NaN (estimate off) counts as the worst.
+                if worst.is_none_or(|(_, c)| condition > c || condition.is_nan()) {
+                    worst = Some((s, condition));
+                }
+                m.fill_trig(s, q, newton.parts.trig);
+            }
+        }
+        SolveError::Singular {
+            time: t,
+            equation: 0,
+            coordinate: 0,
+            condition: f64::INFINITY,
+            deficiency: 0,
+        }
     }
 
     /// ‖D_c⁻¹ (a − b)‖∞: how far apart two configurations are, in scene lengths and radians

@@ -42,6 +42,13 @@ where
     /// Block factorisations whose static pivots were too small and were redone with partial
     /// pivoting (see [`crate::SolverOptions::static_pivot_threshold`]), summed over sub-steps.
     pub fallbacks: usize,
+    /// The sign of det Φ_q at `q` (unit-scaled, in the scene's solve order): +1 or −1. Two
+    /// states of one motion with different signs have a singular configuration (a toggle or
+    /// change point) between them ([`crate::Convergence::orientation`]).
+    pub orientation: i8,
+    /// Whether the solve's Newton iterates crossed a singular configuration
+    /// ([`crate::Convergence::swept`]).
+    pub(crate) swept: bool,
     /// What the scene computes, which decides the CSV columns.
     outputs: Outputs,
     // `fn() -> M` keeps `State` Send/Sync/Clone regardless of `M`.
@@ -127,6 +134,8 @@ where
             condition: f64::NAN,
             evaluations: 0,
             fallbacks: 0,
+            orientation: 1,
+            swept: false,
             outputs: mechanism.outputs(),
             mechanism: PhantomData,
         }
@@ -143,6 +152,8 @@ where
         self.condition = other.condition;
         self.evaluations = other.evaluations;
         self.fallbacks = other.fallbacks;
+        self.orientation = other.orientation;
+        self.swept = other.swept;
     }
 
     /// The outputs this state holds (its scene's).
@@ -278,6 +289,8 @@ where
             condition: self.condition,
             evaluations: self.evaluations,
             fallbacks: self.fallbacks,
+            orientation: self.orientation,
+            swept: self.swept,
             outputs: self.outputs,
             mechanism: PhantomData,
         }
@@ -299,6 +312,7 @@ where
             .field("condition", &self.condition)
             .field("evaluations", &self.evaluations)
             .field("fallbacks", &self.fallbacks)
+            .field("orientation", &self.orientation)
             .field("outputs", &self.outputs)
             .finish()
     }

@@ -46,9 +46,11 @@ pub struct Block<'a> {
     /// Length of the value array the block's kernels work in: the Jacobian's entries, then the
     /// fill-in of its static factorisation.
     pub slots: usize,
-    /// Whether [`Structured::factor`] implements a static-pivot factorisation of the block.
-    /// Without one (the dense reference), the solver always factors with partial pivoting.
-    pub static_pivots: bool,
+    /// The value slot of each pivot of the block's static factorisation ([`Structured::factor`]
+    /// stores each pivot's reciprocal there), in pivot order; the signs of these give the sign
+    /// of the block's determinant. Empty without a static factorisation (the dense reference):
+    /// the solver then always factors with partial pivoting.
+    pub pivots: &'a [usize],
     /// The earlier stages whose coordinates the block's equations read, ascending.
     pub reads: &'a [usize],
 }

@@ -112,7 +112,7 @@ where
             Stage::Explicit { .. } => None,
         })
         .collect();
-    let pieces = if blocks.iter().all(|(_, b)| b.static_pivots) {
+    let pieces = if blocks.iter().all(|(_, b)| !b.pivots.is_empty()) {
         structured(mechanism, &blocks, q, qd, t, batch, batches)
     } else {
         dense(mechanism, &jacobian, q, t, batch, batches)

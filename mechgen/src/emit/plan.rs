@@ -377,14 +377,19 @@ fn stage_table(model: &Model, plan: &Plan) -> TokenStream {
                     quote!((#r, #c))
                 });
                 let slots = idx(block.slots());
-                let static_pivots = block.factorization.is_some();
+                let pivots: Vec<usize> = block
+                    .factorization
+                    .iter()
+                    .flat_map(|f| f.steps.iter().map(|step| step.pivot))
+                    .collect();
+                let pivots = list(&pivots);
                 quote! {
                     ::mechgen_runtime::Stage::Block(::mechgen_runtime::Block {
                         equations: #e,
                         coordinates: #c,
                         pattern: ::mechgen_runtime::Pattern::Sparse(&[#(#pattern),*]),
                         slots: #slots,
-                        static_pivots: #static_pivots,
+                        pivots: #pivots,
                         reads: #reads,
                     })
                 }
