@@ -137,9 +137,9 @@ impl PlanStage {
                     factorization: block.factorization.clone(),
                     pivots: block
                         .factorization
-                        .iter()
-                        .flat_map(|f| f.steps.iter().map(|step| step.pivot))
-                        .collect(),
+                        .as_ref()
+                        .map(Factorization::pivots)
+                        .unwrap_or_default(),
                     velocity_rhs: block.velocity_rhs.as_deref().map(|v| tape(v, Phase::After)),
                     acceleration_rhs: block
                         .acceleration_rhs

@@ -259,6 +259,12 @@ impl Factorization {
         self.slots - self.entries
     }
 
+    /// The slot of each pivot, in pivot order (the runtime reads the determinant's sign from
+    /// their signs).
+    pub fn pivots(&self) -> Vec<usize> {
+        self.steps.iter().map(|step| step.pivot).collect()
+    }
+
     /// Number of multiply-subtract updates of the factorisation.
     pub fn updates(&self) -> usize {
         self.steps.iter().map(|s| s.updates.len()).sum()

@@ -103,8 +103,10 @@ pub(crate) struct Newton<'a, 'w, M> {
     pub fallbacks: usize,
     /// Evaluations (and factorisations) of the block's Jacobian.
     pub evaluations: usize,
-    /// Determinant signs of the factorisations so far: (a positive one, a negative one).
+    /// Determinant signs of the factorisations so far: (a positive one, a negative one), and
+    /// the last one's.
     signs: (bool, bool),
+    orientation: f64,
 }
 
 impl<'a, 'w, M: Structured> Newton<'a, 'w, M>
@@ -126,6 +128,7 @@ where
             fallbacks: 0,
             evaluations: 0,
             signs: (false, false),
+            orientation: 1.0,
         }
     }
 
@@ -264,7 +267,8 @@ where
         self.evaluations += 1;
         if let Ok(factors) = factored {
             self.fallbacks += usize::from(factors.fell_back());
-            if self.bs.orientation(factors, &self.parts.factors) > 0.0 {
+            self.orientation = self.bs.orientation(factors, &self.parts.factors);
+            if self.orientation > 0.0 {
                 self.signs.0 = true;
             } else {
                 self.signs.1 = true;
@@ -363,7 +367,8 @@ where
             iterations,
             residual: max_abs(&self.parts.newton.phi[..self.bs.n()]),
             condition,
-            orientation: self.bs.orientation(factors, &self.parts.factors),
+            // `factors` are the last ones evaluated.
+            orientation: self.orientation,
             swept: self.signs.0 && self.signs.1,
             factors,
         })

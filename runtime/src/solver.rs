@@ -12,7 +12,7 @@ use crate::lu::DEFAULT_PIVOT_TOLERANCE;
 use crate::mechanism::{Accelerations, LengthScale, Outputs, Storage, Vector, Velocities};
 use crate::position::{Newton, Solved};
 use crate::state::State;
-use crate::structure::{Stage, Structured};
+use crate::structure::{Block, Stage, Structured};
 use crate::workspace::{Parts, Workspace};
 
 /// Tolerances and safeguards of the solve.
@@ -468,47 +468,44 @@ where
             diagnosed,
         } = self;
         let mut parts = workspace.parts();
-        let mut worst: Option<(usize, f64)> = None;
-        for pass in 0..2 {
-            for s in 0..m.stage_count() {
-                let block = match m.stage(s) {
-                    Some(Stage::Explicit { .. }) => {
-                        m.fill_trig(s, q, parts.trig);
-                        continue;
-                    }
-                    Some(Stage::Block(block)) => block,
-                    None => break,
-                };
-                let bs = BlockSolve { m, stage: s, block };
-                bs.set_scales(&mut parts.scales, length);
-                let mut newton = Newton::new(bs, &mut parts, options, t);
-                // Second pass: the trig cache is complete; diagnose the worst block.
-                if pass == 1 {
-                    if worst.is_some_and(|(stage, _)| stage == s) {
-                        let condition = worst.map_or(f64::INFINITY, |(_, c)| c);
-                        let error = newton.diagnose(q, condition);
-                        return record(error, m, s, newton.parts, diagnosed);
-                    }
+        let mut worst: Option<(usize, Block<'_>, f64)> = None;
+        for s in 0..m.stage_count() {
+            let block = match m.stage(s) {
+                Some(Stage::Explicit { .. }) => {
+                    m.fill_trig(s, q, parts.trig);
                     continue;
                 }
-                let condition = match newton.factor_at(q) {
-                    Ok(factors) => newton.condition(factors),
-                    Err(error) => return record(error, m, s, newton.parts, diagnosed),
-                };
-                // NaN (estimate off) counts as the worst.
-                if worst.is_none_or(|(_, c)| condition > c || condition.is_nan()) {
-                    worst = Some((s, condition));
-                }
-                m.fill_trig(s, q, newton.parts.trig);
+                Some(Stage::Block(block)) => block,
+                None => break,
+            };
+            let bs = BlockSolve { m, stage: s, block };
+            bs.set_scales(&mut parts.scales, length);
+            let mut newton = Newton::new(bs, &mut parts, options, t);
+            let condition = match newton.factor_at(q) {
+                Ok(factors) => newton.condition(factors),
+                Err(error) => return record(error, m, s, newton.parts, diagnosed),
+            };
+            // NaN (estimate off) counts as the worst.
+            if worst.is_none_or(|(_, _, c)| condition > c || condition.is_nan()) {
+                worst = Some((s, block, condition));
             }
+            m.fill_trig(s, q, newton.parts.trig);
         }
-        SolveError::Singular {
-            time: t,
-            equation: 0,
-            coordinate: 0,
-            condition: f64::INFINITY,
-            deficiency: 0,
-        }
+        // The trig cache is complete: diagnose the worst block.
+        let Some((s, block, condition)) = worst else {
+            return SolveError::Singular {
+                time: t,
+                equation: 0,
+                coordinate: 0,
+                condition: f64::INFINITY,
+                deficiency: 0,
+            };
+        };
+        let bs = BlockSolve { m, stage: s, block };
+        bs.set_scales(&mut parts.scales, length);
+        let mut newton = Newton::new(bs, &mut parts, options, t);
+        let error = newton.diagnose(q, condition);
+        record(error, m, s, newton.parts, diagnosed)
     }
 
     /// ‖D_c⁻¹ (a − b)‖∞: how far apart two configurations are, in scene lengths and radians

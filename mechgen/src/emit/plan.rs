@@ -377,12 +377,8 @@ fn stage_table(model: &Model, plan: &Plan) -> TokenStream {
                     quote!((#r, #c))
                 });
                 let slots = idx(block.slots());
-                let pivots: Vec<usize> = block
-                    .factorization
-                    .iter()
-                    .flat_map(|f| f.steps.iter().map(|step| step.pivot))
-                    .collect();
-                let pivots = list(&pivots);
+                let pivots = block.factorization.as_ref().map(Factorization::pivots);
+                let pivots = list(&pivots.unwrap_or_default());
                 quote! {
                     ::mechgen_runtime::Stage::Block(::mechgen_runtime::Block {
                         equations: #e,
