@@ -7,17 +7,20 @@
 //! one solver implementation of `mechgen-runtime` with scenes read from `.mech` files, and it
 //! agrees with generated code to the bit.
 
-use std::cell::{Cell, RefCell};
+use std::cell::RefCell;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use mechgen::Scene;
 use mechgen::factor::Factorization;
+use mechgen::geometry;
 use mechgen::interpret::{Inputs, Tape};
 use mechgen::kinematics::LengthScale;
 use mechgen::structure::{self, Phase, Plan};
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{
-    Accelerations, Block, Matrix, Mechanism, Outputs, ParameterError, Pattern, Stage, Structured,
-    Unit, VecBuffers, Vector, Velocities,
+    Accelerations, Block, GeometryFault, Matrix, Mechanism, Outputs, ParameterError, Pattern,
+    Requirement, Stage, Structured, Unit, VecBuffers, Vector, Velocities,
 };
 
 /// A scene whose kinematics are interpreted rather than generated.
@@ -43,6 +46,9 @@ pub struct Interpreted {
     /// The folded constant lengths, and a tape of the parameter-dependent ones.
     length_scale: LengthScale,
     lengths: Tape,
+    /// The geometry written in parameters: each value's rule, and one tape for the values.
+    geometry: Vec<geometry::Check>,
+    geometry_values: Tape,
     branch_names: Vec<String>,
     /// One tape per branch invariant (its signed value), and the same reading the trig cache.
     branches: Vec<Tape>,
@@ -55,7 +61,9 @@ pub struct Interpreted {
     /// Tape slots and output values, reused by every call (evaluation is `&self`).
     scratch: RefCell<Scratch>,
     /// Block Jacobian evaluations so far: the unit of a solve's work, which fuzzing bounds.
-    evaluations: Cell<u64>,
+    /// Shared by clones, so a clone kept aside counts the work of a solver that was dropped
+    /// with its error.
+    evaluations: Arc<AtomicU64>,
 }
 
 /// One stage of the plan, with its tapes.
@@ -191,10 +199,11 @@ struct Scratch {
 }
 
 impl Interpreted {
-    /// Block Jacobian evaluations (each with its residual) made since the scene was built: the
-    /// work of every solve, whatever its outcome, counted without a clock.
+    /// Block Jacobian evaluations (each with its residual) made since the scene was built, by
+    /// it and its clones: the work of every solve, whatever its outcome, counted without a
+    /// clock.
     pub fn evaluations(&self) -> u64 {
-        self.evaluations.get()
+        self.evaluations.load(Ordering::Relaxed)
     }
 
     /// Builds the interpreter for a compiled scene (parameters start at their defaults).
@@ -217,6 +226,8 @@ impl Interpreted {
         let nu = kin.nu.as_deref().map(|nu| Tape::new(arena, nu));
         let gamma = kin.gamma.as_deref().map(|gamma| Tape::new(arena, gamma));
         let lengths = Tape::new(arena, &kin.length_scale.dependent);
+        let geometry_ids: Vec<_> = kin.geometry.iter().map(|c| c.value).collect();
+        let geometry_values = Tape::new(arena, &geometry_ids);
         let branches: Vec<Tape> = kin
             .branches
             .iter()
@@ -240,7 +251,7 @@ impl Interpreted {
             .iter()
             .chain(&nu)
             .chain(&gamma)
-            .chain([&lengths])
+            .chain([&lengths, &geometry_values])
             .chain(&branches)
             .chain(&cached_branches)
             .chain(stages.iter().flat_map(PlanStage::tapes))
@@ -251,6 +262,7 @@ impl Interpreted {
             .len()
             .max(model.dim())
             .max(kin.length_scale.dependent.len())
+            .max(kin.geometry.len())
             .max(plan.largest_block() + plan.largest_slots())
             .max(1);
         let [guess, phi, jacobian, phi_and_jacobian] = tapes;
@@ -277,13 +289,15 @@ impl Interpreted {
             equation_units: model.equation_units().into_iter().map(unit).collect(),
             length_scale: kin.length_scale.clone(),
             lengths,
+            geometry: kin.geometry.clone(),
+            geometry_values,
             branch_names: model.branches.iter().map(|b| b.name.clone()).collect(),
             branches,
             cached_branches,
             stages,
             reads: plan.reads.clone(),
             largest: (plan.largest_block(), plan.largest_slots(), plan.trig.len()),
-            evaluations: Cell::new(0),
+            evaluations: Arc::new(AtomicU64::new(0)),
             scratch: RefCell::new(Scratch {
                 slots: vec![0.0; slots],
                 values: vec![0.0; values],
@@ -424,6 +438,24 @@ impl Mechanism for Interpreted {
             scale = self.length_scale.evaluate(&v[..count.min(v.len())]);
         });
         scale
+    }
+
+    fn check_geometry(&self) -> Result<(), GeometryFault> {
+        let mut result = Ok(());
+        if self.geometry.is_empty() {
+            return result;
+        }
+        self.run(&self.geometry_values, self.inputs(&[], &[], 0.0), |v| {
+            result = self.geometry.iter().zip(v).try_for_each(|(c, &value)| {
+                mechgen_runtime::check_geometry(
+                    value,
+                    requirement(c.requirement),
+                    c.equation,
+                    c.parameter,
+                )
+            });
+        });
+        result
     }
 
     fn branch_count(&self) -> usize {
@@ -600,7 +632,7 @@ impl Structured for Interpreted {
         phi: &mut [f64],
         values: &mut [f64],
     ) {
-        self.evaluations.set(self.evaluations.get() + 1);
+        self.evaluations.fetch_add(1, Ordering::Relaxed);
         if let Some(PlanStage::Block {
             jacobian, pattern, ..
         }) = self.stages.get(stage)
@@ -732,5 +764,15 @@ impl Interpreted {
                 out[c] = v;
             }
         }
+    }
+}
+
+/// The runtime's name for a geometric rule.
+fn requirement(requirement: geometry::Requirement) -> Requirement {
+    match requirement {
+        geometry::Requirement::Length => Requirement::Length,
+        geometry::Requirement::Distance => Requirement::Distance,
+        geometry::Requirement::Angle => Requirement::Angle,
+        geometry::Requirement::Axis => Requirement::Axis,
     }
 }

@@ -96,6 +96,9 @@ pub fn assemble(mechanism: Interpreted, t0: f64) -> Result<Simulation<Interprete
     })
 }
 
+const GEOMETRY_HINT: &str = "change the named parameter with `--set NAME=VALUE` (its default is in the scene; \
+     `mechgen check FILE` lists the parameters)";
+
 fn assembly_hint(error: &SolveError) -> &'static str {
     match error {
         SolveError::NoConvergence { .. } => {
@@ -118,6 +121,7 @@ fn assembly_hint(error: &SolveError) -> &'static str {
             "a coordinate is too large to resolve: give `near` angles within a turn and \
              positions near the scene's size, and check parameters that set huge values"
         }
+        SolveError::Geometry { .. } => GEOMETRY_HINT,
         _ => "check the parameter values and the `near` guesses for divisions by zero",
     }
 }
@@ -144,6 +148,7 @@ fn step_hint(error: &SolveError) -> &'static str {
             "a coordinate has grown too large to resolve (a driven angle after very many \
              turns?): start the run at a smaller time, or drive the angle with a periodic law"
         }
+        SolveError::Geometry { .. } => GEOMETRY_HINT,
         _ => "a value became NaN or infinite: check the parameter values and the time range",
     }
 }

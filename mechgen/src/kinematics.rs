@@ -39,6 +39,8 @@ pub struct Kinematics {
     pub branches: Vec<Id>,
     /// The scene's length scale: the largest magnitude among its geometric lengths.
     pub length_scale: LengthScale,
+    /// The geometry written in parameters, with the rule each value must satisfy at run time.
+    pub geometry: Vec<crate::geometry::Check>,
 }
 
 /// The largest magnitude among a scene's geometric lengths ([`Model::lengths`]), split into what
@@ -143,6 +145,7 @@ pub fn derive(model: &mut Model) -> Kinematics {
     let guess = model.bodies.iter().flat_map(|b| b.pose).collect();
     let branches = branch_values(model);
     let length_scale = LengthScale::of(&model.arena, &model.lengths());
+    let geometry = crate::geometry::checks(model);
     Kinematics {
         phi,
         jacobian,
@@ -151,6 +154,7 @@ pub fn derive(model: &mut Model) -> Kinematics {
         guess,
         branches,
         length_scale,
+        geometry,
     }
 }
 

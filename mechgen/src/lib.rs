@@ -20,6 +20,7 @@ pub mod emit;
 pub mod error;
 pub mod expr;
 pub mod factor;
+pub mod geometry;
 pub mod graph;
 pub mod interpret;
 pub mod kinematics;

@@ -21,6 +21,12 @@
 //!
 //! A point is `body @ (x, y)` in the body's frame, or `body` alone for its reference point.
 //!
+//! The `near` guesses describe the mechanism at t = 0: assembling at a later start time that
+//! Newton cannot reach from them directly, the runtime assembles at t = 0 and follows the motion.
+//! Geometry (points, distances, poses, axes) may use parameters but not `t`; a value that breaks
+//! its rule (a distance that is not positive, a NaN) is a compile error when constant and a
+//! typed run-time error naming the parameter otherwise.
+//!
 //! A branch invariant `branch NAME: cross(p1 -> p2, p3 -> p4) > 0;` (or `dot(…)`, or `< 0`)
 //! declares which assembly branch the mechanism stays on: `p1 -> p2` is the world vector from
 //! point `p1` to point `p2` (points as in joints), `cross(u, v)` = u.x v.y − u.y v.x,

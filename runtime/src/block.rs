@@ -143,6 +143,33 @@ where
         Ok((largest, norm1))
     }
 
+    /// Evaluates the block at `q` (into scratch `phi` and `values`) and returns the first of
+    /// its equations with a non-finite value or Jacobian entry: what a `NonFinite` error names.
+    pub fn non_finite_equation(
+        &self,
+        q: &Vector<M::Dim>,
+        trig: &[f64],
+        t: f64,
+        phi: &mut [f64],
+        values: &mut [f64],
+    ) -> Option<usize> {
+        let (n, slots) = (self.n(), self.block.slots);
+        let (phi, values) = (&mut phi[..n], &mut values[..slots]);
+        self.m.block_jacobian(self.stage, q, trig, t, phi, values);
+        let bad = |x: &f64| !x.is_finite();
+        let row = phi
+            .iter()
+            .position(bad)
+            .or_else(|| match self.block.pattern {
+                Pattern::Sparse(entries) => {
+                    let k = values[..entries.len()].iter().position(bad)?;
+                    Some(entries[k].0)
+                }
+                Pattern::Dense => Some(values[..n * n].iter().position(bad)? % n.max(1)),
+            })?;
+        self.block.equations.get(row).copied()
+    }
+
     /// Evaluates at `q` and factors the scaled block Jacobian: with the static pivot order
     /// while every pivot passes its test, otherwise with partial pivoting.
     ///

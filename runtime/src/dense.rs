@@ -125,6 +125,9 @@ where
     fn length_scale(&self) -> f64 {
         self.inner.length_scale()
     }
+    fn check_geometry(&self) -> Result<(), crate::GeometryFault> {
+        self.inner.check_geometry()
+    }
     fn branch_count(&self) -> usize {
         self.inner.branch_count()
     }

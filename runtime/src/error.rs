@@ -4,6 +4,7 @@ use core::fmt;
 
 use nalgebra::DefaultAllocator;
 
+use crate::geometry::{GeometryFault, Requirement};
 use crate::mechanism::{Mechanism, Storage};
 
 /// The quantity found to be NaN or infinite.
@@ -144,6 +145,27 @@ pub enum SolveError {
         time: f64,
         /// Which quantity.
         quantity: Quantity,
+        /// The first equation whose value (Φ, ν, γ), Jacobian row, or closed-form assignment
+        /// (of a position, velocity or acceleration) is not finite: it names the joint or
+        /// driver whose expressions failed (`sqrt` of a negative number, a division by zero).
+        /// `None` for inputs and for values no single equation produced.
+        equation: Option<usize>,
+    },
+    /// A geometric value computed from parameters (a body-fixed point, a distance, a ground
+    /// pose, a prismatic axis) breaks its rule with the current parameter values: a distance
+    /// that is not positive, a NaN from `sqrt` of a negative number or a division by zero. See
+    /// [`crate::Mechanism::check_geometry`].
+    Geometry {
+        /// Time of the solve.
+        time: f64,
+        /// The first equation of the joint or driver the value belongs to.
+        equation: usize,
+        /// The first parameter (by index) the value is computed from.
+        parameter: usize,
+        /// The value.
+        value: f64,
+        /// What it must be.
+        requirement: Requirement,
     },
     /// A vector passed in does not have `dim()` entries (only possible with `Dyn` mechanisms).
     DimensionMismatch {
@@ -152,6 +174,19 @@ pub enum SolveError {
         /// The length passed in.
         found: usize,
     },
+}
+
+impl GeometryFault {
+    /// The fault as the error of a solve at `time`.
+    pub fn at(self, time: f64) -> SolveError {
+        SolveError::Geometry {
+            time,
+            equation: self.equation,
+            parameter: self.parameter,
+            value: self.value,
+            requirement: self.requirement,
+        }
+    }
 }
 
 /// Names for an error's indices, looked up in the mechanism (and the solver's diagnosis).
@@ -172,7 +207,8 @@ impl SolveError {
             | Self::Unresolved { time, .. }
             | Self::Singular { time, .. }
             | Self::BranchFlip { time, .. }
-            | Self::NonFinite { time, .. } => Some(time),
+            | Self::NonFinite { time, .. }
+            | Self::Geometry { time, .. } => Some(time),
             Self::DimensionMismatch { .. } => None,
         }
     }
@@ -290,9 +326,39 @@ impl SolveError {
                      guess towards the declared branch"
                 )
             }
-            Self::NonFinite { time, quantity } => {
+            Self::NonFinite {
+                time,
+                quantity,
+                equation: index,
+            } => {
                 quantity.write(f, names.parameter.or(names.branch))?;
-                write!(f, " became NaN or infinite at t = {time}")
+                write!(f, " became NaN or infinite at t = {time}")?;
+                if let Some(index) = index {
+                    f.write_str(", first in equation ")?;
+                    equation(f, index)?;
+                    f.write_str(
+                        " (check its joint's or driver's expressions for a square root of a \
+                         negative number, a logarithm of zero or a division by zero at this time)",
+                    )?;
+                }
+                Ok(())
+            }
+            Self::Geometry {
+                time,
+                equation: index,
+                parameter,
+                value,
+                requirement,
+            } => {
+                write!(f, "invalid geometry at t = {time}: a value of equation ")?;
+                equation(f, index)?;
+                write!(f, " is {value:e}, computed from ")?;
+                Quantity::Parameter(parameter).write(f, names.parameter)?;
+                write!(
+                    f,
+                    "; it is {}: set the parameter to a value the mechanism can be built with",
+                    requirement.describe()
+                )
             }
             Self::DimensionMismatch { expected, found } => {
                 write!(
@@ -338,10 +404,23 @@ where
                 names.equation = m.equation_name(equation);
                 names.coordinate = m.coordinate_name(coordinate);
             }
-            SolveError::NoAssembly { equation, .. } | SolveError::Unresolved { equation, .. } => {
+            SolveError::NoAssembly { equation, .. }
+            | SolveError::Unresolved { equation, .. }
+            | SolveError::NonFinite {
+                equation: Some(equation),
+                ..
+            } => {
                 names.equation = m.equation_name(equation);
             }
             SolveError::BranchFlip { branch, .. } => names.branch = m.branch_name(branch),
+            SolveError::Geometry {
+                equation,
+                parameter,
+                ..
+            } => {
+                names.equation = m.equation_name(equation);
+                names.parameter = m.parameter_name(parameter);
+            }
             SolveError::NonFinite {
                 quantity: Quantity::Parameter(index),
                 ..
@@ -425,6 +504,12 @@ mod tests {
             SolveError::NonFinite {
                 time: 0.5,
                 quantity: Quantity::Parameter(3),
+                equation: None,
+            },
+            SolveError::NonFinite {
+                time: 0.5,
+                quantity: Quantity::Phi,
+                equation: Some(2),
             },
             SolveError::NoConvergence {
                 time: 0.5,
@@ -444,6 +529,8 @@ mod tests {
                 .contains("`pin.x`")
         );
         assert!(errors[2].to_string().contains("parameter #3"));
+        let phi = errors[3].describe(&pendulum).to_string();
+        assert!(phi.contains("first in equation `drive`"), "{phi}");
         assert!(errors[0].is_step_related() && !errors[2].is_step_related());
     }
 }

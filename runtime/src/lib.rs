@@ -22,13 +22,16 @@ extern crate alloc;
 #[cfg(test)]
 extern crate std;
 
+mod assembly;
 mod block;
 mod crossing;
 mod dense;
 mod error;
+mod geometry;
 mod lu;
 pub mod math;
 mod mechanism;
+mod origin;
 #[cfg(test)]
 mod pendulum;
 mod position;
@@ -38,8 +41,10 @@ mod state;
 mod structure;
 mod workspace;
 
+pub use assembly::{GUESS_TIME, MAX_CONTINUATION_STEPS};
 pub use dense::{Dense, DenseBuffers};
 pub use error::{Described, Quantity, SolveError};
+pub use geometry::{GeometryFault, MAX_LENGTH, Requirement, check_geometry};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use mechanism::{
     Accelerations, Matrix, Mechanism, Outputs, ParameterError, Storage, Unit, Vector, Velocities,

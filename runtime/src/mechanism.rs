@@ -3,6 +3,8 @@
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector};
 
+use crate::geometry::GeometryFault;
+
 /// A column of coordinates or equation values (`Const<N>` for generated scenes: on the stack).
 pub type Vector<D> = OVector<f64, D>;
 /// A square matrix over coordinates × equations, such as the Jacobian Φ_q.
@@ -159,6 +161,17 @@ where
     /// magnitude of the mechanism's size works. Zero or non-finite values make the solver fall
     /// back to 1.
     fn length_scale(&self) -> f64;
+
+    /// Checks the geometry written in parameters (body-fixed points, distances, ground poses,
+    /// prismatic axes) against its rules with the current parameter values; the solver calls
+    /// it before every solve. Scenes whose geometry is constant have nothing to check (the
+    /// default), having been checked at compile time.
+    ///
+    /// # Errors
+    /// A [`GeometryFault`] for the first value that breaks its rule.
+    fn check_geometry(&self) -> Result<(), GeometryFault> {
+        Ok(())
+    }
 
     /// Number of branch invariants the scene declares (`branch NAME: …;` in the spec).
     ///

@@ -288,11 +288,31 @@ where
     }
 
     fn check_phi(&self) -> Result<(), SolveError> {
-        let n = self.bs.n();
-        if all_finite(&self.parts.newton.phi[..n]) {
-            Ok(())
-        } else {
-            Err(non_finite(self.t, Quantity::Phi))
+        let phi = &self.parts.newton.phi[..self.bs.n()];
+        if all_finite(phi) {
+            return Ok(());
+        }
+        let row = phi.iter().position(|x| !x.is_finite());
+        Err(SolveError::NonFinite {
+            time: self.t,
+            quantity: Quantity::Phi,
+            equation: row.and_then(|i| self.bs.block.equations.get(i).copied()),
+        })
+    }
+
+    /// A non-finite Jacobian at `q`, naming the first equation with a non-finite entry.
+    fn non_finite_jacobian(&mut self, q: &Vector<M::Dim>) -> SolveError {
+        let parts = &mut *self.parts;
+        SolveError::NonFinite {
+            time: self.t,
+            quantity: Quantity::Jacobian,
+            equation: self.bs.non_finite_equation(
+                q,
+                parts.trig,
+                self.t,
+                parts.newton.trial,
+                parts.factors.values,
+            ),
         }
     }
 
@@ -386,7 +406,7 @@ where
     pub fn factor_error(&mut self, q: &Vector<M::Dim>, error: LuError) -> SolveError {
         match error {
             LuError::Singular { .. } => self.diagnose(q, f64::INFINITY),
-            _ => non_finite(self.t, Quantity::Jacobian),
+            _ => self.non_finite_jacobian(q),
         }
     }
 
@@ -500,7 +520,7 @@ where
                         deficiency,
                     };
                 }
-                Err(_) => return non_finite(self.t, Quantity::Jacobian),
+                Err(_) => return self.non_finite_jacobian(q),
             }
         }
         SolveError::Singular {
@@ -547,7 +567,7 @@ where
             );
             self.check_phi()?;
             if evaluated.is_err() {
-                return Err(non_finite(self.t, Quantity::Jacobian));
+                return Err(self.non_finite_jacobian(q));
             }
             let parts = &mut *self.parts;
             self.bs
@@ -559,7 +579,7 @@ where
         }
         let largest = self.gradient();
         if !largest.is_finite() {
-            return Err(non_finite(self.t, Quantity::Jacobian));
+            return Err(self.non_finite_jacobian(q));
         }
         if largest == 0.0 {
             // The Jacobian vanishes: no direction reduces the residual.

@@ -1,7 +1,7 @@
 //! Stepping a mechanism through time: each Newton solve warm-started from a predictor, checked
 //! for a jump to another branch, and retried in sub-steps when it fails or jumps; and every
 //! step checked for a singular configuration crossed between two solutions (see
-//! [`crate::crossing`]).
+//! [`crate::crossing`]). Assembly, the first state, is in [`crate::assembly`].
 
 use nalgebra::DefaultAllocator;
 
@@ -84,16 +84,10 @@ impl<M: Structured> Simulation<M>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
-    /// Assembles the mechanism at `t0` from its declared initial guess (predictor on).
-    ///
-    /// # Errors
-    /// The [`SolveError`] of the first solve (the solver is dropped with it).
-    pub fn new(mut solver: Solver<M>, t0: f64) -> Result<Self, SolveError> {
-        let mut current = State::new(solver.mechanism());
-        solver.mechanism().initial_guess(&mut current.q);
-        solver.solve_into(t0, &mut current)?;
-        current.substeps = 1;
-        Ok(Self {
+    /// A simulation starting from `current`, a solved state (predictor on).
+    pub(crate) fn from_state(solver: Solver<M>, mut current: State<M>) -> Self {
+        current.substeps = current.substeps.max(1);
+        Self {
             saved: current.clone(),
             bracket: current.clone(),
             prediction: current.q.clone(),
@@ -103,7 +97,7 @@ where
             has_previous: false,
             predictor: true,
             max_halvings: DEFAULT_MAX_HALVINGS,
-        })
+        }
     }
 
     /// Turns the third-order predictor on or off (off: each solve starts from the last `q`).
@@ -161,10 +155,7 @@ where
     /// further (with its time); the simulation stays at the previous state.
     pub fn step_to(&mut self, t: f64) -> Result<&State<M>, SolveError> {
         if !t.is_finite() {
-            return Err(SolveError::NonFinite {
-                time: t,
-                quantity: Quantity::Time,
-            });
+            return Err(crate::solver::non_finite(t, Quantity::Time));
         }
         match self.advance(t, false) {
             Outcome::Solved => {}

@@ -10,6 +10,7 @@ use crate::block::{BlockSolve, Factors};
 use crate::error::{Described, Quantity, SolveError};
 use crate::lu::DEFAULT_PIVOT_TOLERANCE;
 use crate::mechanism::{Accelerations, LengthScale, Outputs, Storage, Vector, Velocities};
+use crate::origin;
 use crate::position::{Newton, Solved};
 use crate::state::State;
 use crate::structure::{Block, Stage, Structured};
@@ -192,7 +193,7 @@ where
 
 /// What a stage sweep computes besides positions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Rates {
+pub(crate) enum Rates {
     None,
     Velocities,
     Both,
@@ -349,7 +350,8 @@ where
         self.solve_stages(t, q, &mut qd, &mut qdd, Rates::None)
     }
 
-    /// The stage sweep of [`Solver::solve_into`] and [`Solver::solve_position`].
+    /// The stage sweep of [`Solver::solve_into`] and [`Solver::solve_position`], with a
+    /// non-finite value traced to where it began.
     fn solve_stages(
         &mut self,
         t: f64,
@@ -360,6 +362,21 @@ where
     ) -> Result<Convergence, SolveError> {
         self.check_inputs(t, q, Quantity::Guess)?;
         self.check_parameters(t)?;
+        let mut reached = 0;
+        self.sweep(t, q, qd, qdd, rates, &mut reached)
+            .map_err(|e| origin::trace(&self.mechanism, reached, [q, qd, qdd], rates, e))
+    }
+
+    /// Solves the stages in order, recording in `reached` the stage being solved.
+    fn sweep(
+        &mut self,
+        t: f64,
+        q: &mut Vector<M::Dim>,
+        qd: &mut Vector<M::Dim>,
+        qdd: &mut Vector<M::Dim>,
+        rates: Rates,
+        reached: &mut usize,
+    ) -> Result<Convergence, SolveError> {
         self.update_scale();
         self.diagnosed = (0, 0);
         let Self {
@@ -372,6 +389,7 @@ where
         let mut parts = workspace.parts();
         let mut total = Convergence::start(options.estimate_condition);
         for s in 0..m.stage_count() {
+            *reached = s;
             match m.stage(s) {
                 Some(Stage::Explicit { .. }) => {
                     m.assign_positions(s, q, parts.trig, t);
@@ -403,6 +421,7 @@ where
         }
         // Blocks check what they solve; an explicit assignment's non-finite value shows here
         // (or earlier, as the non-finite Φ or rate of a block that reads it).
+        *reached = m.stage_count();
         check_finite(q, t, Quantity::Phi)?;
         check_rates(qd, qdd, t, rates)?;
         check_branches(m, q, parts.trig, t)?;
@@ -421,6 +440,22 @@ where
         rates: Rates,
     ) -> Result<(), SolveError> {
         self.check_parameters(t)?;
+        let mut reached = 0;
+        self.rate_sweep(t, q, qd, qdd, rates, &mut reached)
+            .map_err(|e| origin::trace(&self.mechanism, reached, [q, qd, qdd], rates, e))
+    }
+
+    /// The stages of [`Solver::rate_stages`] in order, recording in `reached` the stage being
+    /// solved.
+    fn rate_sweep(
+        &mut self,
+        t: f64,
+        q: &Vector<M::Dim>,
+        qd: &mut Vector<M::Dim>,
+        qdd: &mut Vector<M::Dim>,
+        rates: Rates,
+        reached: &mut usize,
+    ) -> Result<(), SolveError> {
         self.update_scale();
         self.diagnosed = (0, 0);
         let Self {
@@ -432,6 +467,7 @@ where
         } = self;
         let mut parts = workspace.parts();
         for s in 0..m.stage_count() {
+            *reached = s;
             match m.stage(s) {
                 Some(Stage::Explicit { .. }) => {
                     m.fill_trig(s, q, parts.trig);
@@ -450,6 +486,7 @@ where
                 None => break,
             }
         }
+        *reached = m.stage_count();
         check_rates(qd, qdd, t, rates)
     }
 
@@ -567,13 +604,14 @@ where
         })
     }
 
-    /// Every parameter finite: a NaN set through a public field is reported as itself, not as
-    /// the NaN Φ it would cause.
+    /// Every parameter finite, and the geometry written in them valid: a NaN set through a
+    /// public field, or a distance set negative, is reported as itself, not as the NaN Φ or
+    /// the singular Jacobian it would cause.
     pub(crate) fn check_parameters(&self, t: f64) -> Result<(), SolveError> {
         let m = &self.mechanism;
         match (0..m.parameter_count()).find(|&i| !m.parameter(i).is_some_and(f64::is_finite)) {
             Some(index) => Err(non_finite(t, Quantity::Parameter(index))),
-            None => Ok(()),
+            None => m.check_geometry().map_err(|fault| fault.at(t)),
         }
     }
 
@@ -765,16 +803,38 @@ where
     let n = bs.n();
     let rhs = &mut parts.newton.trial[..n];
     bs.m.velocity_rhs(bs.stage, q, parts.trig, qd, t, rhs);
-    check_slice(rhs, t, Quantity::Nu)?;
+    check_rhs(bs, rhs, t, Quantity::Nu)?;
     bs.solve(factors, &parts.factors, &parts.scales, rhs);
     scatter(rhs, bs.block.coordinates, qd, t, Quantity::Velocity)?;
     if rates == Rates::Both {
         bs.m.acceleration_rhs(bs.stage, q, parts.trig, qd, qdd, t, rhs);
-        check_slice(rhs, t, Quantity::Gamma)?;
+        check_rhs(bs, rhs, t, Quantity::Gamma)?;
         bs.solve(factors, &parts.factors, &parts.scales, rhs);
         scatter(rhs, bs.block.coordinates, qdd, t, Quantity::Acceleration)?;
     }
     Ok(())
+}
+
+/// A block's right-hand side is finite; otherwise the error names its first non-finite row's
+/// equation.
+fn check_rhs<M: Structured>(
+    bs: &BlockSolve<'_, M>,
+    rhs: &[f64],
+    t: f64,
+    quantity: Quantity,
+) -> Result<(), SolveError>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    if all_finite(rhs) {
+        return Ok(());
+    }
+    let row = rhs.iter().position(|x| !x.is_finite());
+    Err(SolveError::NonFinite {
+        time: t,
+        quantity,
+        equation: row.and_then(|i| bs.block.equations.get(i).copied()),
+    })
 }
 
 /// `v[coordinates[j]] ← x[j]`, finite.
@@ -842,8 +902,13 @@ fn larger(largest: f64, d: f64) -> f64 {
     }
 }
 
+/// A non-finite `quantity` that no single equation produced (an input, a step).
 pub(crate) fn non_finite(time: f64, quantity: Quantity) -> SolveError {
-    SolveError::NonFinite { time, quantity }
+    SolveError::NonFinite {
+        time,
+        quantity,
+        equation: None,
+    }
 }
 
 pub(crate) fn check_finite<D: Dim>(

@@ -102,3 +102,215 @@ fn the_seed_assembles_at_any_start_time() {
         );
     }
 }
+
+/// Geometry written in parameters, and drivers whose values fail at some times: the rules the
+/// compiler applies to constants are applied to these before every solve.
+const PARAMETRIC: &str = "
+pub mechanism Parametric {
+    param rod = 80.0;
+    param depth = 4.0;
+    ground frame at (0, 0, 0);
+    body crank near (0, 0, 0);
+    body slider near (100, 0, 0);
+    joint pivot: revolute(frame, crank);
+    joint tie: distance(crank @ (30, 0), slider, rod);
+    joint guide: prismatic(frame @ (0, sqrt(depth - 4)), slider, along (1, 0));
+    driver swing: angle(crank) = sqrt(1 - t);
+}";
+
+mechgen_runtime::mechanism! {
+    mechanism Parametric {
+        param rod = 80.0;
+        param depth = 4.0;
+        ground frame at (0, 0, 0);
+        body crank near (0, 0, 0);
+        body slider near (100, 0, 0);
+        joint pivot: revolute(frame, crank);
+        joint tie: distance(crank @ (30, 0), slider, rod);
+        joint guide: prismatic(frame @ (0, sqrt(depth - 4)), slider, along (1, 0));
+        driver swing: angle(crank) = sqrt(1 - t);
+    }
+}
+
+mechgen_runtime::mechanism! {
+    /// A four-bar driven by the angle between crank and coupler: the driver is one equation of
+    /// the loop's Newton block, not a closed-form assignment.
+    mechanism RelativeDrive {
+        param limit = 1.0;
+        ground frame at (0, 0, 0);
+        body crank near (0, 0, 0);
+        body coupler near (40, 0, 0.6);
+        body rocker near (100, 0, 1.1);
+        joint crank_pivot: revolute(frame, crank);
+        joint crank_pin: revolute(crank @ (40, 0), coupler);
+        joint rocker_pin: revolute(coupler @ (120, 0), rocker @ (80, 0));
+        joint rocker_pivot: revolute(rocker, frame @ (100, 0));
+        driver bend: relative_angle(crank, coupler) = 0.6 - sqrt(limit - t);
+    }
+}
+
+/// The error of assembling `mechanism` at `t`, described with its names.
+fn assembly_error<M: mechgen_runtime::Structured>(mechanism: M, t: f64) -> (SolveError, String)
+where
+    mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
+{
+    let mut solver = Solver::new(mechanism);
+    let mut guess = Vector::<M::Dim>::zeros_generic(solver.mechanism().dim(), Const::<1>);
+    solver.mechanism().initial_guess(&mut guess);
+    let error = solver.solve(t, &guess).expect_err("the solve must fail");
+    let text = error.describe(solver.mechanism()).to_string();
+    (error, text)
+}
+
+#[test]
+fn parameter_geometry_breaking_its_rule_is_a_typed_error_naming_parameter_and_joint() {
+    use mechgen_runtime::Requirement;
+    let interpreted = || interpreted(PARAMETRIC).unwrap();
+    // Generated and interpreted scenes report the same fault.
+    let cases: [(&str, f64, Requirement, &str); 3] = [
+        ("rod", -5.0, Requirement::Distance, "`tie`"),
+        ("rod", 0.0, Requirement::Distance, "`tie`"),
+        ("depth", 3.0, Requirement::Length, "`guide.normal`"),
+    ];
+    for (name, value, expected, equation) in cases {
+        let mut generated = Parametric::default();
+        generated.set_parameter(name, value).unwrap();
+        let mut by_tape = interpreted();
+        by_tape.set_parameter(name, value).unwrap();
+        let (error, text) = assembly_error(generated, 0.0);
+        let (same, _) = assembly_error(by_tape, 0.0);
+        let SolveError::Geometry {
+            requirement, value, ..
+        } = error
+        else {
+            panic!("{name} = {value}: {error:?}");
+        };
+        assert_eq!(requirement, expected, "{text}");
+        assert!(!value.is_finite() || value <= 0.0, "{text}");
+        assert!(
+            same == error || (matches!(same, SolveError::Geometry { value, .. } if value.is_nan())),
+            "{same:?} vs {error:?}"
+        );
+        assert!(
+            text.contains(&format!("parameter `{name}`")) && text.contains(equation),
+            "{text}"
+        );
+        assert!(!error.is_step_related());
+    }
+    // Valid parameters solve.
+    let mut solver = Solver::new(Parametric::default());
+    let mut guess = Vector::<Const<9>>::zeros();
+    solver.mechanism().initial_guess(&mut guess);
+    solver.solve(0.5, &guess).unwrap();
+}
+
+#[test]
+fn a_non_finite_equation_names_its_driver_where_the_nan_began() {
+    // A closed-form driver (the crank angle) whose NaN every later block reads.
+    let (error, text) = assembly_error(Parametric::default(), 2.0);
+    assert!(
+        matches!(
+            error,
+            SolveError::NonFinite {
+                equation: Some(_),
+                ..
+            }
+        ),
+        "{error:?}"
+    );
+    assert!(text.contains("first in equation `swing`"), "{text}");
+    let (_, text) = assembly_error(interpreted(PARAMETRIC).unwrap(), 2.0);
+    assert!(text.contains("first in equation `swing`"), "{text}");
+
+    // A driver inside the loop's Newton block.
+    let (error, text) = assembly_error(RelativeDrive::default(), 2.0);
+    assert!(
+        matches!(
+            error,
+            SolveError::NonFinite {
+                quantity: mechgen_runtime::Quantity::Phi,
+                equation: Some(_),
+                ..
+            }
+        ),
+        "{error:?}"
+    );
+    assert!(text.contains("first in equation `bend`"), "{text}");
+}
+
+mechgen_runtime::mechanism! {
+    /// The crank-rocker four-bar of the examples driven through the angle between crank and
+    /// coupler, which turns fully (Grashof), at `omega`.
+    mechanism BentFourBar {
+        param omega = 10.0;
+        ground frame at (0, 0, 0);
+        body crank near (0, 0, 0);
+        body coupler near (40, 0, 0.6);
+        body rocker near (100, 0, 1.1);
+        joint crank_pivot: revolute(frame, crank);
+        joint crank_pin: revolute(crank @ (40, 0), coupler);
+        joint rocker_pin: revolute(coupler @ (120, 0), rocker @ (80, 0));
+        joint rocker_pivot: revolute(rocker, frame @ (100, 0));
+        driver bend: relative_angle(crank, coupler) = 0.6 - omega * t;
+        branch open_assembly: cross(coupler @ (120, 0) -> coupler, rocker @ (80, 0) -> rocker) > 0;
+    }
+}
+
+#[test]
+fn assembly_far_from_the_guess_continues_in_time_from_where_the_guess_fits() {
+    for t0 in [10.0, 30.0] {
+        // Newton from the guess alone does not get there: the driven angle is 100 to 300 rad
+        // from it, inside the loop's Newton block.
+        let mut direct = Solver::new(BentFourBar::default());
+        let mut guess = Vector::<Const<12>>::zeros();
+        direct.mechanism().initial_guess(&mut guess);
+        assert!(direct.solve(t0, &guess).is_err(), "t0 = {t0}");
+
+        let simulation = Simulation::new(Solver::new(BentFourBar::default()), t0)
+            .unwrap_or_else(|e| panic!("t0 = {t0}: {e}"));
+        let state = simulation.state();
+        assert_eq!(state.t, t0);
+        assert!(state.substeps > 1, "the continuation's steps are counted");
+
+        // The same state as following the motion from t = 0 in fine steps: the same winding of
+        // every angle, on the declared branch.
+        let mut stepped = Simulation::new(Solver::new(BentFourBar::default()), 0.0).unwrap();
+        let steps = (t0 * 200.0) as usize;
+        stepped.run(t0, steps, |_| {}).unwrap();
+        let difference = (state.q - stepped.state().q).amax();
+        assert!(difference < 1e-9, "t0 = {t0}: {difference:e}");
+        let mut phi = Vector::<Const<12>>::zeros();
+        simulation.solver().mechanism().phi(&state.q, t0, &mut phi);
+        assert!(phi.amax() < 1e-9 * (1.0 + 10.0 * t0), "{:e}", phi.amax());
+    }
+}
+
+#[test]
+fn a_start_time_the_motion_cannot_reach_keeps_the_direct_error() {
+    // Links that lock (40 + 120 > 80 + 60, not Grashof): the relative angle cannot turn fully.
+    // The mechanism assembles at t = 0 and locks at t ≈ 0.18, so neither the direct solve nor
+    // the continuation from t = 0 reaches t0 = 5, and the direct solve's error comes back
+    // after a bounded amount of work.
+    let source = "
+        pub mechanism Locked {
+            ground frame at (0, 0, 0);
+            body crank near (0, 0, 0);
+            body coupler near (40, 0, 0.6);
+            body rocker near (60, 0, 1.1);
+            joint crank_pivot: revolute(frame, crank);
+            joint crank_pin: revolute(crank @ (40, 0), coupler);
+            joint rocker_pin: revolute(coupler @ (120, 0), rocker @ (80, 0));
+            joint rocker_pivot: revolute(rocker, frame @ (60, 0));
+            driver bend: relative_angle(crank, coupler) = 3 - 10 * t;
+        }";
+    let mechanism = interpreted(source).unwrap();
+    // The clone shares the evaluation counter with the solver's copy, dropped with the error.
+    let result = Simulation::new(Solver::new(mechanism.clone()), 5.0);
+    let error = result.err().expect("t0 = 5 is out of reach");
+    assert!(error.time() == Some(5.0), "{error:?}");
+    // The direct solve, then the continuation up to the lock (about 1,000 in all).
+    let evaluations = mechanism.evaluations();
+    assert!(evaluations > 0 && evaluations < 10_000, "{evaluations}");
+    // Before the lock, the start time is reached.
+    Simulation::new(Solver::new(mechanism), 0.15).unwrap();
+}

@@ -223,7 +223,8 @@ fn non_finite_parameters_and_times_are_typed_errors() {
         error,
         SolveError::NonFinite {
             time: 0.0,
-            quantity: Quantity::Parameter(1)
+            quantity: Quantity::Parameter(1),
+            equation: None,
         }
     );
     assert!(

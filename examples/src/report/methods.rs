@@ -184,6 +184,10 @@ macro_rules! delegate_to_inner {
             self.inner.length_scale()
         }
 
+        fn check_geometry(&self) -> Result<(), mechgen_runtime::GeometryFault> {
+            self.inner.check_geometry()
+        }
+
         fn branch_count(&self) -> usize {
             self.inner.branch_count()
         }

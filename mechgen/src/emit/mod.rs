@@ -199,6 +199,7 @@ impl Context<'_> {
             }
         });
         let length_scale = self.length_scale(kin);
+        let check_geometry = self.check_geometry(kin);
         let branch_methods = self.branch_methods(kin);
         let equations = self.textbook_functions(kin);
         let (outputs_variant, markers) = match model.outputs {
@@ -277,6 +278,8 @@ impl Context<'_> {
                 }
 
                 #length_scale
+
+                #check_geometry
 
                 #branch_methods
 
@@ -564,6 +567,62 @@ impl Context<'_> {
             #[doc = #doc]
             fn length_scale(&self) -> f64 {
                 #body
+            }
+        }
+    }
+
+    /// `check_geometry` for a scene with geometry written in parameters (the runtime's default,
+    /// nothing to check, otherwise): each value evaluated with the current parameters and
+    /// checked against its rule, in declaration order ([`crate::geometry`]).
+    fn check_geometry(&self, kin: &Kinematics) -> TokenStream {
+        let checks = &kin.geometry;
+        if checks.is_empty() {
+            return TokenStream::new();
+        }
+        let names: Vec<Ident> = (0..checks.len())
+            .map(|k| format_ident!("value{}", k))
+            .collect();
+        let outputs: Vec<(TokenStream, Id)> = names
+            .iter()
+            .zip(checks)
+            .map(|(name, c)| (quote!(let #name), c.value))
+            .collect();
+        let zero = names
+            .iter()
+            .zip(checks)
+            .filter(|&(_, c)| self.arena().is_zero(c.value))
+            .map(|(name, _)| quote! { let #name = 0.0f64; });
+        let zero: Vec<TokenStream> = zero.collect();
+        let evaluated = self
+            .function(&outputs, TokenStream::new(), &computed())
+            .body;
+        let tests = names.iter().zip(checks).map(|(name, c)| {
+            let requirement = format_ident!("{}", c.requirement.name());
+            let (equation, parameter) = (idx(c.equation), idx(c.parameter));
+            quote! {
+                ::mechgen_runtime::check_geometry(
+                    #name,
+                    ::mechgen_runtime::Requirement::#requirement,
+                    #equation,
+                    #parameter,
+                )?;
+            }
+        });
+        let doc = format!(
+            " Checks the geometry written in parameters ({} value{}) against the runtime's \
+             rules, with the current parameters.",
+            checks.len(),
+            if checks.len() == 1 { "" } else { "s" },
+        );
+        quote! {
+            #[doc = #doc]
+            fn check_geometry(
+                &self,
+            ) -> ::core::result::Result<(), ::mechgen_runtime::GeometryFault> {
+                #evaluated
+                #(#zero)*
+                #(#tests)*
+                ::core::result::Result::Ok(())
             }
         }
     }
