@@ -2,7 +2,8 @@
 //! [`Interpreted`] adapter that runs `.mech` scenes through the runtime's solver.
 //!
 //! The binary is a thin wrapper around [`run`]; the pieces are public so that tests and reports
-//! can reuse them. Sample times come from [`mechgen_runtime::sample_time`], as in the examples.
+//! can reuse them. Equally spaced sample times come from [`mechgen_runtime::sample_time`], as
+//! in the examples; listed ones (`--at`, `--times`) are solved at exactly the doubles given.
 
 pub mod args;
 pub mod diagnostics;
@@ -14,10 +15,11 @@ use std::ffi::OsString;
 use std::io::{self, Read, Write};
 use std::path::Path;
 
-pub use args::{Command, USAGE};
+pub use args::Command;
 pub use interpreted::Interpreted;
 
-use args::{Input, Output, SolveArgs};
+use args::{Input, Output, SolveArgs, Times};
+use mechgen_runtime::sample_time;
 
 /// Exit status for a bad command line.
 pub const EXIT_USAGE: u8 = 2;
@@ -27,7 +29,7 @@ pub const EXIT_FAILURE: u8 = 1;
 /// How a command failed.
 #[derive(Debug)]
 enum Failure {
-    /// A bad command line: the message is followed by the usage.
+    /// A bad command line: clap's message, with the usage line.
     Usage(String),
     /// Anything else: the complete text for stderr.
     Failed(String),
@@ -48,14 +50,16 @@ pub fn run(
 ) -> u8 {
     let outcome = match args::parse(args) {
         Ok(command) => execute(command, stdout, stderr),
-        Err(error) => Err(Failure::Usage(error.0)),
+        // `--help` and `--version` arrive as "errors" that belong on stdout.
+        Err(error) if !error.use_stderr() => print(stdout, &error.render().to_string()),
+        Err(error) => Err(Failure::Usage(error.render().to_string())),
     };
     let outcome = outcome.and_then(|()| stdout.flush().map_err(|e| write_failure(&e, "stdout")));
     // Nothing sensible is left to do if stderr itself cannot be written.
     match outcome {
         Ok(()) | Err(Failure::BrokenPipe) => 0,
         Err(Failure::Usage(message)) => {
-            let _ = write!(stderr, "error: {message}\n\n{USAGE}");
+            let _ = write!(stderr, "{message}");
             EXIT_USAGE
         }
         Err(Failure::Failed(message)) => {
@@ -71,8 +75,13 @@ fn execute(
     stderr: &mut dyn Write,
 ) -> Result<(), Failure> {
     match command {
-        Command::Help => print(stdout, USAGE),
-        Command::Version => print(stdout, &format!("mechgen {}\n", env!("CARGO_PKG_VERSION"))),
+        Command::Completions(shell) => {
+            let mut script = Vec::new();
+            args::completions(shell, &mut script);
+            stdout
+                .write_all(&script)
+                .map_err(|e| write_failure(&e, "stdout"))
+        }
         Command::Expand { input } => {
             let source = read_source(&input)?;
             let code = mechgen::expand_pretty(&source.text)
@@ -152,11 +161,20 @@ fn compile_failure(source: &Source, errors: &mechgen::Errors) -> Failure {
 fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
     let source = read_source(&args.input)?;
     let scene = compile(&source)?;
+    let listed = match &args.times {
+        Times::Equal { .. } => Vec::new(),
+        Times::Listed(times) => times.clone(),
+        Times::File(path) => read_times(path)?,
+    };
+    let t0 = match args.times {
+        Times::Equal { t0, .. } => t0,
+        _ => listed[0],
+    };
     let mut mechanism = Interpreted::new(&scene);
     solve::apply_sets(&mut mechanism, &args.sets).map_err(failed)?;
     // Assemble before touching the output, so that a scene that cannot move leaves an existing
     // CSV file as it was.
-    let mut simulation = solve::assemble(mechanism, args.t0).map_err(failed)?;
+    let mut simulation = solve::assemble(mechanism, t0).map_err(failed)?;
 
     let mut file;
     let (out, destination): (&mut dyn Write, String) = match &args.csv {
@@ -174,27 +192,72 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         }
     };
 
-    let range = format!("t = {} to {}", args.t0, args.t_end);
-    match solve::run(&mut simulation, args.t_end, args.steps, out) {
+    let (outcome, range) = match args.times {
+        Times::Equal { t0, t_end, steps } => (
+            solve::run(
+                &mut simulation,
+                (1..steps + 1).map(|k| sample_time(t0, t_end, steps, k)),
+                args.diagnostics,
+                out,
+            ),
+            format!("t = {t0} to {t_end} in {}", count(steps, "equal step")),
+        ),
+        _ => {
+            let last = listed[listed.len() - 1];
+            let range = format!(
+                "{} from t = {t0} to {last}",
+                count(listed.len(), "listed time")
+            );
+            let rest = listed[1..].iter().copied();
+            (
+                solve::run(&mut simulation, rest, args.diagnostics, out),
+                range,
+            )
+        }
+    };
+    match outcome {
         Ok(summary) => {
             let _ = writeln!(
                 stderr,
-                "mechgen: wrote {} rows to {destination} ({range}, {} step{}); {} Newton \
-                 iterations in total; max residual ‖Φ‖∞ = {:e}",
-                summary.rows,
-                args.steps,
-                if args.steps == 1 { "" } else { "s" },
-                summary.iterations,
-                summary.max_residual
+                "mechgen: wrote {} to {destination} ({range}); {} in total; largest residual \
+                 ‖Φ‖∞ = {}",
+                count(summary.rows, "row"),
+                count(summary.iterations, "Newton iteration"),
+                readable(summary.max_residual)
             );
             Ok(())
         }
         Err(solve::RunError::Write(e)) => Err(write_failure(&e, &destination)),
         Err(solve::RunError::Solve { message, summary }) => Err(failed(format_args!(
-            "{message}\n  note: wrote {} rows to {destination} ({} Newton iterations) before \
-             the failure",
-            summary.rows, summary.iterations
+            "{message}\n  note: wrote {} to {destination} ({}) before the failure",
+            count(summary.rows, "row"),
+            count(summary.iterations, "Newton iteration"),
         ))),
+    }
+}
+
+/// The times of a `--times` file.
+fn read_times(path: &Path) -> Result<Vec<f64>, Failure> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| read_failure(&name, &e))?;
+    args::parse_times(&text, &name).map_err(failed)
+}
+
+/// `1 row`, `3 rows`.
+fn count(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
+/// A residual for people: `0`, or two significant digits (`1.4e-14`).
+fn readable(x: f64) -> String {
+    if x == 0.0 {
+        "0".to_owned()
+    } else {
+        format!("{x:.1e}")
     }
 }
 

@@ -4,9 +4,7 @@
 use std::io::Write;
 
 use mechgen_runtime::nalgebra::DVector;
-use mechgen_runtime::{
-    Mechanism, Simulation, SolveError, Solver, State, sample_time, write_csv_header,
-};
+use mechgen_runtime::{Mechanism, Simulation, SolveError, Solver, State, write_csv_header};
 
 use crate::Interpreted;
 
@@ -153,21 +151,30 @@ fn step_hint(error: &SolveError) -> &'static str {
     }
 }
 
-/// Writes the CSV header and the rows of an assembled simulation over `steps` equal steps
-/// from its current time `t0` to `t_end`, flushing `out` even when a solve fails.
+/// The per-step diagnostic columns of `--diagnostics`, after the kinematic ones.
+pub const DIAGNOSTIC_COLUMNS: &str = "iterations,substeps,evaluations,fallbacks,condition,det_sign";
+
+/// Writes the CSV header and one row per time: the assembled state (at its own time), then a
+/// step to each of `times`, flushing `out` even when a solve fails. With `diagnostics`, each
+/// row ends with the [`DIAGNOSTIC_COLUMNS`] of its solve.
 ///
 /// # Errors
 /// [`RunError::Write`] when `out` fails, [`RunError::Solve`] when a step does.
 pub fn run(
     simulation: &mut Simulation<Interpreted>,
-    t_end: f64,
-    steps: usize,
+    times: impl ExactSizeIterator<Item = f64>,
+    diagnostics: bool,
     out: &mut dyn Write,
 ) -> Result<Summary, RunError> {
-    let t0 = simulation.state().t;
     let mut line = String::new();
     // Writing to a String cannot fail.
     let _ = write_csv_header(simulation.solver().mechanism(), &mut line);
+    if diagnostics {
+        line.pop();
+        line.push(',');
+        line.push_str(DIAGNOSTIC_COLUMNS);
+        line.push('\n');
+    }
     out.write_all(line.as_bytes()).map_err(RunError::Write)?;
 
     let dim = simulation.solver().mechanism().len();
@@ -180,6 +187,10 @@ pub fn run(
         let state: &State<Interpreted> = simulation.state();
         line.clear();
         let _ = state.write_csv_row(&mut line);
+        if diagnostics {
+            line.pop();
+            let _ = write_diagnostics(state, &mut line);
+        }
         out.write_all(line.as_bytes()).map_err(RunError::Write)?;
         // The state does not keep the solver's residual; Φ at the returned q is that residual.
         simulation
@@ -193,8 +204,8 @@ pub fn run(
     };
 
     record(simulation, out, &mut summary)?;
-    for k in 1..=steps {
-        let t = sample_time(t0, t_end, steps, k);
+    let steps = times.len();
+    for (k, t) in (1..).zip(times) {
         if let Err(error) = simulation.step_to(t) {
             out.flush().map_err(RunError::Write)?;
             let message = format!(
@@ -208,6 +219,21 @@ pub fn run(
     }
     out.flush().map_err(RunError::Write)?;
     Ok(summary)
+}
+
+/// `,iterations,substeps,evaluations,fallbacks,condition,det_sign` of a state, and the newline.
+fn write_diagnostics(state: &State<Interpreted>, out: &mut String) -> core::fmt::Result {
+    use core::fmt::Write as _;
+    writeln!(
+        out,
+        ",{},{},{},{},{:?},{}",
+        state.iterations,
+        state.substeps,
+        state.evaluations,
+        state.fallbacks,
+        state.condition,
+        state.orientation
+    )
 }
 
 #[cfg(test)]

@@ -133,6 +133,7 @@ fn solve_writes_one_row_per_sample_time() {
     assert!(out.stdout.is_empty(), "the CSV went to the file");
     let summary = text(&out.stderr);
     assert!(summary.contains("wrote 9 rows"), "{summary}");
+    assert!(summary.contains("8 equal steps"), "{summary}");
     assert!(summary.contains("Newton iterations"), "{summary}");
 
     let written = std::fs::read_to_string(&csv).expect("CSV written");
@@ -270,11 +271,10 @@ fn unreadable_files_say_so() {
 }
 
 #[test]
-fn bad_command_lines_exit_2_with_usage() {
+fn bad_command_lines_exit_2_with_a_short_usage() {
     let seed = scene("piston_crank.mech");
     for args in [
-        &[][..],
-        &["frobnicate"],
+        &["frobnicate"][..],
         &["check"],
         &["check", &seed, "--verbose"],
         &["expand", &seed, "--stats"],
@@ -284,24 +284,160 @@ fn bad_command_lines_exit_2_with_usage() {
         &[
             "solve", &seed, "--t-end", "1", "--steps", "2", "--set", "omega",
         ],
+        &["solve", &seed, "--at", "0.2,0.1"],
     ] {
         let out = mechgen(args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let message = text(&out.stderr);
         assert!(message.starts_with("error: "), "{args:?}: {message}");
-        assert!(
-            message.contains("Usage:\n  mechgen expand FILE"),
-            "{args:?}: {message}"
-        );
+        // The usage line or a pointer to `--help`, not the whole manual.
+        assert!(message.contains("--help"), "{args:?}: {message}");
+        assert!(message.lines().count() <= 8, "{args:?}: {message}");
         assert!(out.stdout.is_empty(), "{args:?}");
     }
+    // No command at all: the overview, on stderr, still a usage error.
+    let out = mechgen(&[]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(text(&out.stderr).contains("Commands:"));
 }
 
 #[test]
-fn help_goes_to_stdout_and_succeeds() {
-    for args in [&["help"][..], &["--help"], &["-h"], &["solve", "--help"]] {
+fn misspelt_commands_and_flags_get_a_suggestion() {
+    let seed = scene("piston_crank.mech");
+    let out = mechgen(&["chek", &seed]);
+    assert!(text(&out.stderr).contains("similar subcommand exists: 'check'"));
+    let out = mechgen(&["check", &seed, "--stat"]);
+    assert!(text(&out.stderr).contains("similar argument exists: '--stats'"));
+}
+
+#[test]
+fn help_goes_to_stdout_and_succeeds_per_subcommand() {
+    for (args, expected) in [
+        (&["help"][..], "Commands:"),
+        (&["--help"], "Commands:"),
+        (&["-h"], "Commands:"),
+        (&["solve", "--help"], "--diagnostics"),
+        (&["help", "solve"], "t_k = T0 + k·h"),
+        (&["check", "--help"], "--stats"),
+        (&["--version"], "mechgen 0.1.0"),
+    ] {
         let out = mechgen(args);
         assert!(out.status.success(), "{args:?}");
-        assert!(text(&out.stdout).contains("Usage:"), "{args:?}");
+        let help = text(&out.stdout);
+        assert!(help.contains(expected), "{args:?}: {help}");
+    }
+    let check = text(&mechgen(&["check", "--help"]).stdout);
+    assert!(!check.contains("--t-end"), "{check}");
+}
+
+#[test]
+fn completions_are_printed_for_each_shell() {
+    for shell in ["bash", "zsh", "fish", "powershell", "elvish"] {
+        let out = mechgen(&["completions", shell]);
+        assert!(out.status.success(), "{shell}");
+        assert!(text(&out.stdout).contains("solve"), "{shell}");
+    }
+}
+
+/// The `t` column and the diagnostic columns of a `solve` run's CSV.
+fn csv_rows(out: &Output) -> (Vec<String>, Vec<Vec<String>>) {
+    let csv = text(&out.stdout);
+    let mut lines = csv.lines();
+    let header: Vec<String> = lines
+        .next()
+        .unwrap_or_default()
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(str::to_owned).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn listed_times_are_solved_at_exactly_those_doubles() {
+    let seed = scene("piston_crank.mech");
+    // Times no equal-step formula produces, written in shortest round-trip form.
+    let times = [
+        "0.001",
+        "0.0013333333333333333",
+        "0.30000000000000004",
+        "0.31",
+    ];
+    let out = mechgen(&["solve", &seed, "--at", &times.join(",")]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (_, rows) = csv_rows(&out);
+    let written: Vec<&str> = rows.iter().map(|r| r[0].as_str()).collect();
+    assert_eq!(written, times);
+    for (row, time) in rows.iter().zip(times) {
+        let parsed: f64 = row[0].parse().unwrap();
+        assert_eq!(parsed.to_bits(), time.parse::<f64>().unwrap().to_bits());
+    }
+
+    let path = scratch("times.txt");
+    std::fs::write(
+        &path,
+        "# measured\n0.001\n\n0.0013333333333333333 # second\n",
+    )
+    .unwrap();
+    let out = mechgen(&["solve", &seed, "--times", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (_, from_file) = csv_rows(&out);
+    assert_eq!(from_file, rows[..2]);
+    assert!(
+        text(&out.stderr).contains("wrote 2 rows"),
+        "{}",
+        text(&out.stderr)
+    );
+
+    std::fs::write(&path, "0.1\nsoon\n").unwrap();
+    let out = mechgen(&["solve", &seed, "--times", path.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains(":2: `soon`"),
+        "{}",
+        text(&out.stderr)
+    );
+    let _ = std::fs::remove_file(&path);
+}
+
+#[test]
+fn diagnostics_add_per_step_columns() {
+    let seed = scene("piston_crank.mech");
+    let out = mechgen(&[
+        "solve",
+        &seed,
+        "--t-end",
+        "0.02",
+        "--steps",
+        "4",
+        "--diagnostics",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let (header, rows) = csv_rows(&out);
+    let tail = &header[header.len() - 6..];
+    assert_eq!(
+        tail,
+        [
+            "iterations",
+            "substeps",
+            "evaluations",
+            "fallbacks",
+            "condition",
+            "det_sign"
+        ]
+    );
+    assert_eq!(rows.len(), 5);
+    for row in &rows {
+        assert_eq!(row.len(), header.len());
+        let n = row.len();
+        let iterations: usize = row[n - 6].parse().unwrap();
+        let substeps: usize = row[n - 5].parse().unwrap();
+        let condition: f64 = row[n - 2].parse().unwrap();
+        let sign: i8 = row[n - 1].parse().unwrap();
+        assert!(iterations >= 1 && substeps >= 1, "{row:?}");
+        assert!(condition >= 1.0 && condition.is_finite(), "{row:?}");
+        assert!(sign == 1 || sign == -1, "{row:?}");
     }
 }

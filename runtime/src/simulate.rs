@@ -385,14 +385,16 @@ where
     true
 }
 
-/// The k-th of `steps` equal steps from `t0` to `t_end`: `t0 + k·(t_end − t0)/steps`, computed
-/// from the ends rather than accumulated (no drift), and exactly `t_end` at `k = steps`. Every
-/// caller sampling a motion (the CLI, examples, tests) uses this so their times agree to the bit.
+/// The k-th of `steps` equal steps from `t0` to `t_end`: `t0 + k·h` with
+/// `h = (t_end − t0)/steps` (each time computed from `t0`, not accumulated, so there is no
+/// drift), and exactly `t_end` at `k = steps`. This is the documented formula of
+/// `mechgen solve --steps`, so a user can reproduce its times to the bit; every caller sampling
+/// a motion (the CLI, examples, tests) uses it.
 pub fn sample_time(t0: f64, t_end: f64, steps: usize, k: usize) -> f64 {
     if k >= steps {
         t_end
     } else {
-        t0 + k as f64 * (t_end - t0) / steps as f64
+        t0 + k as f64 * ((t_end - t0) / steps as f64)
     }
 }
 
@@ -411,7 +413,7 @@ mod tests {
             2.0 * core::f64::consts::PI / 314.0
         );
         assert_eq!(sample_time(1.0, -1.0, 4, 2), 0.0);
-        assert_eq!(sample_time(0.0, 1.0, 10, 3), 0.3);
+        assert_eq!(sample_time(0.0, 1.0, 10, 3), 3.0 * 0.1);
         let accumulated = (0..3).fold(0.0, |t, _| t + 1.0 / 10.0);
         assert_ne!(accumulated, 0.3);
     }
