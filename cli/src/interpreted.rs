@@ -7,9 +7,7 @@
 //! one solver implementation of `mechgen-runtime` with scenes read from `.mech` files, and it
 //! agrees with generated code to the bit.
 
-use std::cell::RefCell;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::cell::{Cell, RefCell};
 
 use mechgen::Scene;
 use mechgen::factor::Factorization;
@@ -61,9 +59,7 @@ pub struct Interpreted {
     /// Tape slots and output values, reused by every call (evaluation is `&self`).
     scratch: RefCell<Scratch>,
     /// Block Jacobian evaluations so far: the unit of a solve's work, which fuzzing bounds.
-    /// Shared by clones, so a clone kept aside counts the work of a solver that was dropped
-    /// with its error.
-    evaluations: Arc<AtomicU64>,
+    evaluations: Cell<u64>,
 }
 
 /// One stage of the plan, with its tapes.
@@ -199,11 +195,10 @@ struct Scratch {
 }
 
 impl Interpreted {
-    /// Block Jacobian evaluations (each with its residual) made since the scene was built, by
-    /// it and its clones: the work of every solve, whatever its outcome, counted without a
-    /// clock.
+    /// Block Jacobian evaluations (each with its residual) made since the scene was built: the
+    /// work of every solve, whatever its outcome, counted without a clock.
     pub fn evaluations(&self) -> u64 {
-        self.evaluations.load(Ordering::Relaxed)
+        self.evaluations.get()
     }
 
     /// Builds the interpreter for a compiled scene (parameters start at their defaults).
@@ -297,7 +292,7 @@ impl Interpreted {
             stages,
             reads: plan.reads.clone(),
             largest: (plan.largest_block(), plan.largest_slots(), plan.trig.len()),
-            evaluations: Arc::new(AtomicU64::new(0)),
+            evaluations: Cell::new(0),
             scratch: RefCell::new(Scratch {
                 slots: vec![0.0; slots],
                 values: vec![0.0; values],
@@ -404,15 +399,20 @@ impl Mechanism for Interpreted {
         self.params.get(index).copied()
     }
 
-    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParameterError> {
+    fn set_parameter<'a>(
+        &'a mut self,
+        name: &'a str,
+        value: f64,
+    ) -> Result<(), ParameterError<'a>> {
+        let Some(index) = self.param_names.iter().position(|p| p == name) else {
+            return Err(ParameterError::Unknown {
+                name,
+                declared: &self.param_names,
+            });
+        };
         if !value.is_finite() {
-            return Err(ParameterError::NonFinite);
+            return Err(ParameterError::NonFinite { name, value });
         }
-        let index = self
-            .param_names
-            .iter()
-            .position(|p| p == name)
-            .ok_or(ParameterError::Unknown)?;
         self.params[index] = value;
         Ok(())
     }
@@ -632,7 +632,7 @@ impl Structured for Interpreted {
         phi: &mut [f64],
         values: &mut [f64],
     ) {
-        self.evaluations.fetch_add(1, Ordering::Relaxed);
+        self.evaluations.set(self.evaluations.get() + 1);
         if let Some(PlanStage::Block {
             jacobian, pattern, ..
         }) = self.stages.get(stage)

@@ -82,14 +82,11 @@ fn declared_parameters(mechanism: &Interpreted) -> String {
 /// # Errors
 /// The solver's error, described with the scene's names and a hint.
 pub fn assemble(mechanism: Interpreted, t0: f64) -> Result<Simulation<Interpreted>, String> {
-    // `Simulation::new` drops the solver (and the mechanism's names) on failure.
-    let names = mechanism.clone();
-    Simulation::new(Solver::new(mechanism), t0).map_err(|error| {
+    Simulation::new(Solver::new(mechanism), t0).map_err(|failure| {
         format!(
-            "cannot assemble `{}`: {}\n  hint: {}",
-            names.name(),
-            error.describe(&names),
-            assembly_hint(&error)
+            "cannot assemble `{}`: {failure}\n  hint: {}",
+            failure.solver.mechanism().name(),
+            assembly_hint(&failure.error)
         )
     })
 }

@@ -154,6 +154,7 @@ where
     let mut states: Vec<State<M>> = Vec::with_capacity(steps + 1);
     let started = Instant::now();
     let result = Simulation::new(Solver::with_options(mechanism, options), 0.0)
+        .map_err(SolveError::from)
         .and_then(|mut s| s.run(t_end, steps, |state| states.push(state.clone())));
     let micros_per_step = started.elapsed().as_secs_f64() * 1e6 / (steps + 1) as f64;
     let mut tracker = ErrorTracker::new();

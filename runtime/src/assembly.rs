@@ -12,6 +12,8 @@
 //! t0 is the one continuous motion from the assembled start arrives at, with the declared
 //! branch kept; if the continuation fails too, the direct solve's error is returned.
 
+use core::fmt;
+
 use nalgebra::DefaultAllocator;
 
 use crate::error::SolveError;
@@ -43,24 +45,32 @@ where
     /// [`State::substeps`], and its work in [`State::iterations`] and [`State::evaluations`].
     ///
     /// # Errors
-    /// The [`SolveError`] of the solve at `t0` (the solver is dropped with it).
-    pub fn new(mut solver: Solver<M>, t0: f64) -> Result<Self, SolveError> {
+    /// An [`AssemblyError`]: the [`SolveError`] of the solve at `t0`, with the solver handed
+    /// back, so that the error is displayed with the scene's names (and converts into the
+    /// plain [`SolveError`] with `?`).
+    // Without an allocator the solver can only be handed back by value; the `Ok` variant, a
+    // `Simulation` holding one, is larger still.
+    #[allow(clippy::result_large_err)]
+    pub fn new(mut solver: Solver<M>, t0: f64) -> Result<Self, AssemblyError<M>> {
         let mut current = State::new(solver.mechanism());
         solver.mechanism().initial_guess(&mut current.q);
         match solver.solve_into(t0, &mut current) {
             Ok(()) => Ok(Self::from_state(solver, current)),
             Err(error) if error.is_step_related() && t0 != GUESS_TIME && t0.is_finite() => {
-                Self::continue_to(solver, t0).ok_or(error)
+                Self::continue_to(solver, t0).map_err(|solver| AssemblyError { error, solver })
             }
-            Err(error) => Err(error),
+            Err(error) => Err(AssemblyError { error, solver }),
         }
     }
 
-    /// Assembles at [`GUESS_TIME`] and steps to `t0`; `None` if either fails.
-    fn continue_to(mut solver: Solver<M>, t0: f64) -> Option<Self> {
+    /// Assembles at [`GUESS_TIME`] and steps to `t0`; the solver back if either fails.
+    #[allow(clippy::result_large_err)]
+    fn continue_to(mut solver: Solver<M>, t0: f64) -> Result<Self, Solver<M>> {
         let mut current = State::new(solver.mechanism());
         solver.mechanism().initial_guess(&mut current.q);
-        solver.solve_into(GUESS_TIME, &mut current).ok()?;
+        if solver.solve_into(GUESS_TIME, &mut current).is_err() {
+            return Err(solver);
+        }
         let mut simulation = Self::from_state(solver, current);
         let mut h = (t0 - GUESS_TIME) * FIRST_STEP;
         let (mut steps, mut iterations, mut evaluations) = (0, 0, 0);
@@ -70,7 +80,7 @@ where
                 break;
             }
             if steps == MAX_CONTINUATION_STEPS {
-                return None;
+                return Err(simulation.solver);
             }
             // Within a hair of the end, take the end exactly rather than leave a sliver.
             let target = if (t0 - reached).abs() <= 1.000_001 * h.abs() {
@@ -78,7 +88,10 @@ where
             } else {
                 reached + h
             };
-            let state = simulation.step_to(target).ok()?;
+            let state = match simulation.step_to(target) {
+                Ok(state) => state,
+                Err(_) => return Err(simulation.solver),
+            };
             (iterations, evaluations) = (
                 iterations + state.iterations,
                 evaluations + state.evaluations,
@@ -103,6 +116,49 @@ where
         }
         let state = &mut simulation.states[simulation.newest];
         (state.substeps, state.iterations, state.evaluations) = (steps, iterations, evaluations);
-        Some(simulation)
+        Ok(simulation)
+    }
+}
+
+/// A failed [`Simulation::new`]: the error, and the solver it came from, so that the error can
+/// be displayed with the scene's names ([`Solver::describe`]; `Display` and `Debug` do it) and
+/// the solver reused (with other options or parameters).
+pub struct AssemblyError<M: Structured>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    /// What went wrong, and when.
+    pub error: SolveError,
+    /// The solver, with the diagnosis of a [`SolveError::Singular`].
+    pub solver: Solver<M>,
+}
+
+impl<M: Structured> fmt::Display for AssemblyError<M>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.solver.describe(&self.error))
+    }
+}
+
+/// The named description, so that `unwrap` and `expect` show it.
+impl<M: Structured> fmt::Debug for AssemblyError<M>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{self}")
+    }
+}
+
+impl<M: Structured> core::error::Error for AssemblyError<M> where DefaultAllocator: Storage<M::Dim> {}
+
+impl<M: Structured> From<AssemblyError<M>> for SolveError
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    fn from(failure: AssemblyError<M>) -> Self {
+        failure.error
     }
 }

@@ -113,7 +113,11 @@ where
     fn parameter(&self, index: usize) -> Option<f64> {
         self.inner.parameter(index)
     }
-    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParameterError> {
+    fn set_parameter<'a>(
+        &'a mut self,
+        name: &'a str,
+        value: f64,
+    ) -> Result<(), ParameterError<'a>> {
         self.inner.set_parameter(name, value)
     }
     fn coordinate_unit(&self, index: usize) -> Unit {

@@ -41,13 +41,14 @@ mod state;
 mod structure;
 mod workspace;
 
-pub use assembly::{GUESS_TIME, MAX_CONTINUATION_STEPS};
+pub use assembly::{AssemblyError, GUESS_TIME, MAX_CONTINUATION_STEPS};
 pub use dense::{Dense, DenseBuffers};
 pub use error::{Described, Quantity, SolveError};
 pub use geometry::{GeometryFault, MAX_LENGTH, Requirement, check_geometry};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use mechanism::{
-    Accelerations, Matrix, Mechanism, Outputs, ParameterError, Storage, Unit, Vector, Velocities,
+    Accelerations, Matrix, Mechanism, Outputs, ParameterError, ParameterNames, Storage, Unit,
+    Vector, Velocities,
 };
 pub use simulate::{DEFAULT_MAX_HALVINGS, Simulation, sample_time};
 pub use solver::{Convergence, Solver, SolverOptions};

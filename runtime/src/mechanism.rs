@@ -17,25 +17,82 @@ pub type Matrix<D> = OMatrix<f64, D, D>;
 pub trait Storage<D: Dim>: Allocator<D> + Allocator<D, D> {}
 impl<D: Dim, A: Allocator<D> + Allocator<D, D>> Storage<D> for A {}
 
-/// Error from setting a parameter by name.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ParameterError {
-    /// No parameter of that name was declared in the scene.
-    Unknown,
-    /// The value is NaN or infinite.
-    NonFinite,
+/// The names of a scene's parameters, in declaration order, as a [`ParameterError`] lists them:
+/// a generated scene's `&'static [&'static str]`, or an interpreted scene's strings.
+pub trait ParameterNames {
+    /// Name `index`; `None` past the end.
+    fn parameter_name(&self, index: usize) -> Option<&str>;
 }
 
-impl core::fmt::Display for ParameterError {
+impl<const N: usize> ParameterNames for [&str; N] {
+    fn parameter_name(&self, index: usize) -> Option<&str> {
+        self.get(index).copied()
+    }
+}
+
+#[cfg(feature = "alloc")]
+impl ParameterNames for alloc::vec::Vec<alloc::string::String> {
+    fn parameter_name(&self, index: usize) -> Option<&str> {
+        self.get(index).map(alloc::string::String::as_str)
+    }
+}
+
+/// Error from setting a parameter by name: it names the parameter, and for an unknown one lists
+/// the parameters the scene declares, so that its `Display` says how to fix the call.
+#[derive(Clone, Copy)]
+pub enum ParameterError<'a> {
+    /// No parameter of that name was declared in the scene.
+    Unknown {
+        /// The name asked for.
+        name: &'a str,
+        /// The parameters the scene declares.
+        declared: &'a dyn ParameterNames,
+    },
+    /// The value is NaN or infinite (the mechanism is left unchanged).
+    NonFinite {
+        /// The parameter.
+        name: &'a str,
+        /// The value refused.
+        value: f64,
+    },
+}
+
+impl ParameterError<'_> {
+    /// Whether the name was unknown (as opposed to the value refused).
+    pub fn is_unknown(&self) -> bool {
+        matches!(self, Self::Unknown { .. })
+    }
+}
+
+impl core::fmt::Display for ParameterError<'_> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            Self::Unknown => f.write_str("no parameter of that name is declared in the scene"),
-            Self::NonFinite => f.write_str("parameter values must be finite"),
+        match *self {
+            Self::Unknown { name, declared } => {
+                write!(f, "the scene declares no parameter `{name}`")?;
+                let names = (0..).map_while(|i| declared.parameter_name(i));
+                for (i, declared) in names.enumerate() {
+                    let lead = if i == 0 { "; declared: " } else { ", " };
+                    write!(f, "{lead}`{declared}`")?;
+                }
+                if declared.parameter_name(0).is_none() {
+                    f.write_str(" (it declares none)")?;
+                }
+                Ok(())
+            }
+            Self::NonFinite { name, value } => {
+                write!(f, "parameter `{name}` must be a finite number, not {value}")
+            }
         }
     }
 }
 
-impl core::error::Error for ParameterError {}
+impl core::fmt::Debug for ParameterError<'_> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(f, "ParameterError({self})")
+    }
+}
+
+impl core::error::Error for ParameterError<'_> {}
 
 /// Which kinematic outputs a scene computes: the spec's `outputs` line (default: all three).
 ///
@@ -145,9 +202,11 @@ where
     /// Sets a parameter by name.
     ///
     /// # Errors
-    /// [`ParameterError::Unknown`] if no parameter has that name, [`ParameterError::NonFinite`] for
-    /// NaN or infinite values (the mechanism is left unchanged).
-    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParameterError>;
+    /// [`ParameterError::Unknown`] if no parameter has that name (listing the declared ones),
+    /// [`ParameterError::NonFinite`] for NaN or infinite values (the mechanism is left
+    /// unchanged).
+    fn set_parameter<'a>(&'a mut self, name: &'a str, value: f64)
+    -> Result<(), ParameterError<'a>>;
 
     /// Physical dimension of coordinate `index` (past the end: [`Unit::Angle`], unscaled).
     fn coordinate_unit(&self, index: usize) -> Unit;

@@ -65,8 +65,11 @@ impl Mechanism for Pendulum {
     fn parameter(&self, _: usize) -> Option<f64> {
         None
     }
-    fn set_parameter(&mut self, _: &str, _: f64) -> Result<(), ParameterError> {
-        Err(ParameterError::Unknown)
+    fn set_parameter<'a>(&'a mut self, name: &'a str, _: f64) -> Result<(), ParameterError<'a>> {
+        Err(ParameterError::Unknown {
+            name,
+            declared: &[] as &[&str; 0],
+        })
     }
     fn coordinate_unit(&self, index: usize) -> Unit {
         if index < 2 { Unit::Length } else { Unit::Angle }
@@ -170,8 +173,15 @@ mod dynamic {
         fn parameter(&self, _: usize) -> Option<f64> {
             None
         }
-        fn set_parameter(&mut self, _: &str, _: f64) -> Result<(), ParameterError> {
-            Err(ParameterError::Unknown)
+        fn set_parameter<'a>(
+            &'a mut self,
+            name: &'a str,
+            _: f64,
+        ) -> Result<(), ParameterError<'a>> {
+            Err(ParameterError::Unknown {
+                name,
+                declared: &[] as &[&str; 0],
+            })
         }
         fn coordinate_unit(&self, index: usize) -> Unit {
             self.0.coordinate_unit(index)

@@ -205,9 +205,8 @@ pub fn run(source: &str, tally: &mut Tally) {
     let names = mechanism.clone();
     let mut simulation = match Simulation::new(Solver::new(mechanism), 0.0) {
         Ok(simulation) => simulation,
-        Err(_) => {
-            // `names` shares the evaluation counter of the solver dropped with the error.
-            let evaluations = names.evaluations();
+        Err(failure) => {
+            let evaluations = failure.solver.mechanism().evaluations();
             assert!(
                 evaluations <= budget(&names, 1),
                 "{evaluations} evaluations to fail assembly:\n{source}"

@@ -117,7 +117,7 @@ fn generated_scenes_solve_without_allocating() {
     assert!(substeps > 7, "{substeps}");
     let unclosable = Simulation::new(Solver::new(Unclosable::default()), 0.0);
     assert!(matches!(
-        unclosable.err(),
+        unclosable.map_err(|failure| failure.error).err(),
         Some(SolveError::NoAssembly { .. })
     ));
     let mut toggle = Simulation::new(

@@ -304,13 +304,31 @@ fn a_start_time_the_motion_cannot_reach_keeps_the_direct_error() {
             driver bend: relative_angle(crank, coupler) = 3 - 10 * t;
         }";
     let mechanism = interpreted(source).unwrap();
-    // The clone shares the evaluation counter with the solver's copy, dropped with the error.
-    let result = Simulation::new(Solver::new(mechanism.clone()), 5.0);
-    let error = result.err().expect("t0 = 5 is out of reach");
-    assert!(error.time() == Some(5.0), "{error:?}");
+    let failure = Simulation::new(Solver::new(mechanism.clone()), 5.0)
+        .err()
+        .expect("t0 = 5 is out of reach");
+    assert!(failure.error.time() == Some(5.0), "{failure}");
     // The direct solve, then the continuation up to the lock (about 1,000 in all).
-    let evaluations = mechanism.evaluations();
+    let evaluations = failure.solver.mechanism().evaluations();
     assert!(evaluations > 0 && evaluations < 10_000, "{evaluations}");
     // Before the lock, the start time is reached.
     Simulation::new(Solver::new(mechanism), 0.15).unwrap();
+}
+
+#[test]
+fn parameter_errors_name_the_parameter_and_list_the_declared_ones() {
+    let mut generated = PistonCrank::default();
+    let error = generated.set_parameter("omgea", 100.0).unwrap_err();
+    assert!(error.is_unknown());
+    let text = error.to_string();
+    assert!(
+        text.contains("no parameter `omgea`") && text.contains("declared: `omega`"),
+        "{text}"
+    );
+    let text = generated.set_parameter("omega", f64::NAN).unwrap_err().to_string();
+    assert!(text.contains("`omega` must be a finite number"), "{text}");
+
+    let mut by_tape = interpreted(SEED).unwrap();
+    let text = by_tape.set_parameter("omgea", 1.0).unwrap_err().to_string();
+    assert!(text.contains("declared: `omega`"), "{text}");
 }

@@ -260,7 +260,11 @@ where
 {
     delegate_to_inner!();
 
-    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParameterError> {
+    fn set_parameter<'a>(
+        &'a mut self,
+        name: &'a str,
+        value: f64,
+    ) -> Result<(), ParameterError<'a>> {
         self.inner.set_parameter(name, value)
     }
 
@@ -330,7 +334,11 @@ where
 {
     delegate_to_inner!();
 
-    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParameterError> {
+    fn set_parameter<'a>(
+        &'a mut self,
+        name: &'a str,
+        value: f64,
+    ) -> Result<(), ParameterError<'a>> {
         self.inner.set_parameter(name, value)
     }
 
@@ -616,14 +624,19 @@ where
 {
     delegate_to_inner!();
 
-    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParameterError> {
-        self.inner.set_parameter(name, value)?;
-        for (k, slot) in self.params.iter_mut().enumerate() {
-            if self.inner.parameter_name(k) == Some(name) {
-                *slot = value;
-            }
+    fn set_parameter<'a>(
+        &'a mut self,
+        name: &'a str,
+        value: f64,
+    ) -> Result<(), ParameterError<'a>> {
+        // The copy first: the inner error borrows the inner mechanism for as long as it lives.
+        let index = (0..self.inner.parameter_count())
+            .find(|&k| self.inner.parameter_name(k) == Some(name));
+        if let (Some(slot), true) = (index.and_then(|k| self.params.get_mut(k)), value.is_finite())
+        {
+            *slot = value;
         }
-        Ok(())
+        self.inner.set_parameter(name, value)
     }
 
     fn phi(&self, q: &Vector<M::Dim>, t: f64, out: &mut Vector<M::Dim>) {

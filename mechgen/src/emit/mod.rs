@@ -247,19 +247,24 @@ impl Context<'_> {
                     }
                 }
 
-                fn set_parameter(
-                    &mut self,
-                    name: &str,
+                fn set_parameter<'a>(
+                    &'a mut self,
+                    name: &'a str,
                     value: f64,
-                ) -> ::core::result::Result<(), ::mechgen_runtime::ParameterError> {
-                    if !value.is_finite() {
+                ) -> ::core::result::Result<(), ::mechgen_runtime::ParameterError<'a>> {
+                    if !value.is_finite() && Self::PARAMETERS.contains(&name) {
                         return ::core::result::Result::Err(
-                            ::mechgen_runtime::ParameterError::NonFinite,
+                            ::mechgen_runtime::ParameterError::NonFinite { name, value },
                         );
                     }
                     match name {
                         #(#param_writes)*
-                        _ => ::core::result::Result::Err(::mechgen_runtime::ParameterError::Unknown),
+                        _ => ::core::result::Result::Err(
+                            ::mechgen_runtime::ParameterError::Unknown {
+                                name,
+                                declared: &Self::PARAMETERS,
+                            },
+                        ),
                     }
                 }
 

@@ -127,13 +127,20 @@ impl Mechanism for SliderCrank {
         self.parameters.get(index).copied()
     }
 
-    fn set_parameter(&mut self, name: &str, value: f64) -> Result<(), ParameterError> {
+    fn set_parameter<'a>(
+        &'a mut self,
+        name: &'a str,
+        value: f64,
+    ) -> Result<(), ParameterError<'a>> {
         let index = PARAMETERS
             .iter()
             .position(|&p| p == name)
-            .ok_or(ParameterError::Unknown)?;
+            .ok_or(ParameterError::Unknown {
+                name,
+                declared: &PARAMETERS,
+            })?;
         if !value.is_finite() {
-            return Err(ParameterError::NonFinite);
+            return Err(ParameterError::NonFinite { name, value });
         }
         self.parameters[index] = value;
         Ok(())
