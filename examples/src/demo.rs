@@ -25,13 +25,28 @@ pub struct Options {
 }
 
 impl Options {
-    /// Parses `--csv PATH` and `--svg PATH` (default `target/NAME.svg` in the workspace).
+    /// Parses `--csv PATH` and `--svg PATH`. The plot goes by default to `NAME.svg` in Cargo's
+    /// target directory: `$CARGO_TARGET_DIR` when set, else the workspace's `target/`.
     ///
     /// # Errors
     /// A message naming the unknown flag or missing value.
     pub fn from_args(name: &str, args: impl IntoIterator<Item = String>) -> Result<Self, String> {
-        let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-        let target = workspace.canonicalize().unwrap_or(workspace).join("target");
+        Self::parse(name, args, std::env::var_os("CARGO_TARGET_DIR"))
+    }
+
+    /// [`Options::from_args`] with the target directory given.
+    fn parse(
+        name: &str,
+        args: impl IntoIterator<Item = String>,
+        target_dir: Option<std::ffi::OsString>,
+    ) -> Result<Self, String> {
+        let target = match target_dir {
+            Some(dir) if !dir.is_empty() => PathBuf::from(dir),
+            _ => {
+                let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+                workspace.canonicalize().unwrap_or(workspace).join("target")
+            }
+        };
         let mut options = Options {
             csv: None,
             svg: target.join(format!("{name}.svg")),
@@ -138,8 +153,8 @@ impl<M: Mechanism<Dim = Const<N>>, const N: usize> Revolution<M, N> {
         Ok(())
     }
 
-    /// Writes the SVG plot (a failure is a warning: the table was printed already) and, when
-    /// asked for, the CSV (a failure exits with status 1).
+    /// Writes the SVG plot (creating its directory) and, when asked for, the CSV, printing
+    /// where; a failure to write either exits with status 1.
     pub fn write_outputs(
         &self,
         options: &Options,
@@ -147,19 +162,41 @@ impl<M: Mechanism<Dim = Const<N>>, const N: usize> Revolution<M, N> {
         x_label: &str,
         panels: &[Panel<'_>],
     ) {
-        match plot::write_svg(&options.svg, title, x_label, panels) {
-            Ok(()) => println!("plot: {}", options.svg.display()),
-            Err(e) => eprintln!("warning: {e} ({})", options.svg.display()),
+        if let Err(message) = self.try_write_outputs(options, title, x_label, panels) {
+            eprintln!("error: {message}");
+            std::process::exit(1);
         }
+    }
+
+    /// [`Revolution::write_outputs`] without the exit.
+    ///
+    /// # Errors
+    /// What could not be written, with a hint.
+    pub fn try_write_outputs(
+        &self,
+        options: &Options,
+        title: &str,
+        x_label: &str,
+        panels: &[Panel<'_>],
+    ) -> Result<(), String> {
+        let directory = options.svg.parent().filter(|d| !d.as_os_str().is_empty());
+        directory
+            .map_or(Ok(()), std::fs::create_dir_all)
+            .map_err(Box::<dyn Error>::from)
+            .and_then(|()| Ok(plot::write_svg(&options.svg, title, x_label, panels)?))
+            .map_err(|e| {
+                format!(
+                    "writing the plot {}: {e}\n  hint: give a writable path with `--svg PATH`",
+                    options.svg.display()
+                )
+            })?;
+        println!("plot: {}", options.svg.display());
         if let Some(path) = &options.csv {
-            match self.write_csv(path) {
-                Ok(()) => println!("csv: {} ({} rows)", path.display(), self.states.len()),
-                Err(e) => {
-                    eprintln!("error: writing {}: {e}", path.display());
-                    std::process::exit(1);
-                }
-            }
+            self.write_csv(path)
+                .map_err(|e| format!("writing {}: {e}", path.display()))?;
+            println!("csv: {} ({} rows)", path.display(), self.states.len());
         }
+        Ok(())
     }
 
     /// The accuracy-and-cost summary printed by the examples.
@@ -193,4 +230,63 @@ where
 {
     eprintln!("error: {}", error.describe(mechanism));
     std::process::exit(1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::closed_form;
+    use crate::plot::Series;
+    use crate::scenes::FourBar;
+
+    fn args(list: &[&str]) -> Vec<String> {
+        list.iter().map(|s| (*s).to_owned()).collect()
+    }
+
+    #[test]
+    fn the_plot_goes_to_cargo_s_target_directory_or_where_asked() {
+        let options = Options::parse("four_bar", args(&[]), Some("/elsewhere".into())).unwrap();
+        assert_eq!(options.svg, Path::new("/elsewhere/four_bar.svg"));
+        let options = Options::parse("four_bar", args(&[]), None).unwrap();
+        assert!(options.svg.ends_with("target/four_bar.svg"), "{options:?}");
+        let options =
+            Options::parse("four_bar", args(&["--svg", "p.svg"]), Some("/x".into())).unwrap();
+        assert_eq!(options.svg, Path::new("p.svg"));
+        assert!(Options::parse("four_bar", args(&["--png"]), None).is_err());
+    }
+
+    #[test]
+    fn a_plot_that_cannot_be_written_is_an_error() {
+        let exact = closed_form::FourBar::default();
+        let run = revolution(FourBar::default(), exact.period(), 12, |t| {
+            exact.kinematics(t)
+        })
+        .unwrap();
+        let points = [(0.0, 0.0), (1.0, 1.0)];
+        let series = [Series {
+            name: "line",
+            points: &points,
+        }];
+        let panels = [Panel {
+            y_label: "y",
+            series: &series,
+        }];
+        let dir = std::env::temp_dir().join(format!("mechgen-demo-{}", std::process::id()));
+        let written = Options {
+            csv: None,
+            svg: dir.join("new/plot.svg"),
+        };
+        run.try_write_outputs(&written, "t", "x", &panels).unwrap();
+        assert!(written.svg.exists());
+        // A path under a regular file: its directory cannot be created.
+        let blocked = Options {
+            csv: None,
+            svg: written.svg.join("plot.svg"),
+        };
+        let error = run
+            .try_write_outputs(&blocked, "t", "x", &panels)
+            .unwrap_err();
+        assert!(error.contains("writing the plot"), "{error}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -4,8 +4,9 @@
 use proc_macro::TokenStream;
 
 /// Declares a planar mechanism and generates its kinematics (Φ, Φ_q, ν, γ) as straight-line Rust.
+/// Errors are reported at the offending tokens, with a hint.
 ///
-/// The grammar is documented in `mechgen::parse`; errors are reported at the offending tokens.
+#[doc = include_str!("../../docs/grammar.md")]
 #[proc_macro]
 pub fn mechanism(input: TokenStream) -> TokenStream {
     mechgen::expand_or_errors(input.into()).into()

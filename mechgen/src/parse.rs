@@ -1,40 +1,9 @@
 //! Parsing: tokens (a `mechanism!` body or a `.mech` file) into a [`Spec`].
 //!
-//! The grammar, statement by statement (`//` comments and `///` doc comments as in Rust):
+//! The grammar (the reference below is `docs/grammar.md`, also on the `mechanism!` macro and
+//! the runtime's front page). Only syntax is checked here; `check` does the rest.
 //!
-//! ```text
-//! /// docs                                      carried onto the generated struct
-//! pub mechanism PistonCrank {
-//!     param omega = 314.0;                      run-time parameter with its default
-//!     ground liner at (156.8, 0, 0);            fixed body: pose (x, y, θ)
-//!     body piston near (130, 0, 0);             moving body: initial guess (x, y, θ)
-//!     joint pin: revolute(rod @ (41.3, 0), crank @ (0, 43));
-//!     joint slide: prismatic(liner, piston, along (1, 0));
-//!     joint link: distance(a @ (0, 10), b, 120);
-//!     driver crank: angle(crank) = omega * t;   also relative_angle(a, b), x(point),
-//!                                                y(point), travel(prismatic_joint)
-//!     branch open: cross(a @ (1, 0) -> b, b -> c) > 0;
-//!                                               branch invariant; also dot(…), and `< 0`
-//!     outputs positions, velocities;            optional; default: all three
-//! }
-//! ```
-//!
-//! A point is `body @ (x, y)` in the body's frame, or `body` alone for its reference point.
-//!
-//! The `near` guesses describe the mechanism at t = 0: assembling at a later start time that
-//! Newton cannot reach from them directly, the runtime assembles at t = 0 and follows the motion.
-//! Geometry (points, distances, poses, axes) may use parameters but not `t`; a value that breaks
-//! its rule (a distance that is not positive, a NaN) is a compile error when constant and a
-//! typed run-time error naming the parameter otherwise.
-//!
-//! A branch invariant `branch NAME: cross(p1 -> p2, p3 -> p4) > 0;` (or `dot(…)`, or `< 0`)
-//! declares which assembly branch the mechanism stays on: `p1 -> p2` is the world vector from
-//! point `p1` to point `p2` (points as in joints), `cross(u, v)` = u.x v.y − u.y v.x,
-//! `dot(u, v)` = u.x v.x + u.y v.y, compared strictly with the literal `0`. The solver refuses a
-//! solution where the sign is wrong instead of switching branch silently.
-//!
-//! Expressions use numbers, `t`, parameters, `+ - * /`, unary minus, `^` with an integer
-//! exponent, parentheses and `sin cos tan exp ln sqrt`. Only syntax is checked here.
+#![doc = include_str!("../../docs/grammar.md")]
 
 use proc_macro2::TokenStream;
 use syn::parse::{Parse, ParseStream};

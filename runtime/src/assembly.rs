@@ -40,8 +40,10 @@ where
 {
     /// Assembles the mechanism at `t0` from its declared initial guess (predictor on): by
     /// Newton's method directly, or, when that fails in a way stepping may cure and `t0` is not
-    /// the guesses' own time, by assembling at t = 0 and following the motion to `t0` (see the
-    /// [`crate::assembly`] docs). The state then counts the continuation's steps in
+    /// the guesses' own time ([`GUESS_TIME`]), by assembling at t = 0 and following the motion
+    /// to `t0` with every stepping safeguard, in steps that move the solution about 0.2 scene
+    /// lengths or radians, at most [`MAX_CONTINUATION_STEPS`] of them; the state reached is the
+    /// one continuous motion arrives at. The state then counts the continuation's steps in
     /// [`State::substeps`], and its work in [`State::iterations`] and [`State::evaluations`].
     ///
     /// # Errors

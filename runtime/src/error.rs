@@ -73,7 +73,37 @@ impl fmt::Display for Quantity {
 ///
 /// Indices name equations, coordinates, branches and parameters of the scene; name them with
 /// [`SolveError::describe`] (the first equation and coordinate involved) or
-/// [`crate::Solver::describe`] (every one).
+/// [`crate::Solver::describe`] (every one). A failed [`crate::Simulation::new`] hands its solver
+/// back in a [`crate::AssemblyError`], whose `Display` does this.
+///
+/// ```
+/// # use mechgen_runtime::mechanism;
+/// # mechanism! {
+/// #     /// Links too short to close: 10 + 20 + 20 cannot span 100.
+/// #     pub mechanism Unclosable {
+/// #         ground frame at (0, 0, 0);
+/// #         body crank near (0, 0, 0);
+/// #         body coupler near (10, 0, 0);
+/// #         body rocker near (100, 0, 3);
+/// #         joint pivot: revolute(frame, crank);
+/// #         joint pin: revolute(crank @ (10, 0), coupler);
+/// #         joint elbow: revolute(coupler @ (20, 0), rocker @ (20, 0));
+/// #         joint rest: revolute(rocker, frame @ (100, 0));
+/// #         driver turn: angle(crank) = t;
+/// #     }
+/// # }
+/// use mechgen_runtime::{Simulation, SolveError, Solver};
+///
+/// let Err(failure) = Simulation::new(Solver::new(Unclosable::default()), 0.0) else {
+///     panic!("cannot close");
+/// };
+/// let SolveError::NoAssembly { residual, .. } = failure.error else {
+///     panic!("{failure}");
+/// };
+/// assert!(residual > 10.0);
+/// // Named: "… largest in equation `elbow.x` …" (or another of the loop's equations).
+/// assert!(failure.to_string().contains("largest in equation `"));
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SolveError {
     /// Newton–Raphson hit the iteration cap while still reducing the residual.

@@ -12,6 +12,38 @@
 //! [`Dense`] solves any mechanism as one dense block (the reference). Failures are
 //! [`SolveError`]s; [`Solver::describe`] names the equations and coordinates involved.
 //! [`State::write_csv_row`] writes results without a heap.
+//!
+//! # Quick start
+//!
+//! ```
+//! use mechgen_runtime::{Simulation, Solver, mechanism};
+//!
+//! mechanism! {
+//!     /// A slider-crank (mm, rad, s).
+//!     pub mechanism SliderCrank {
+//!         /// Crank speed (rad/s).
+//!         param omega = 10.0;
+//!         ground frame at (0, 0, 0);
+//!         body crank near (0, 0, 0.5);
+//!         body rod near (35, 19, -0.19);
+//!         body slider near (133, 0, 0);
+//!         joint pivot: revolute(frame, crank);
+//!         joint crank_pin: revolute(crank @ (40, 0), rod);
+//!         joint wrist: revolute(rod @ (100, 0), slider);
+//!         joint guide: prismatic(frame, slider, along (1, 0));
+//!         driver turn: angle(crank) = 0.5 + omega * t;
+//!     }
+//! }
+//!
+//! // Assemble at t = 0, then step: positions, velocities and accelerations at each time.
+//! let mut simulation = Simulation::new(Solver::new(SliderCrank::default()), 0.0)?;
+//! let state = simulation.step_to(0.01)?;
+//! let slider = state.slider();
+//! println!("x = {:.3} mm, ẋ = {:.1} mm/s, ẍ = {:.0} mm/s²", slider.x, slider.x_dot, slider.x_ddot);
+//! # Ok::<(), mechgen_runtime::SolveError>(())
+//! ```
+//!
+#![doc = include_str!("../../docs/grammar.md")]
 #![no_std]
 // The runtime must build without std or alloc: catch `std::` paths that `core::` provides.
 #![warn(clippy::std_instead_of_core, clippy::alloc_instead_of_core)]

@@ -28,6 +28,35 @@ pub const DEFAULT_MAX_HALVINGS: u32 = 10;
 ///
 /// Holds four states and alternates between two of them, so stepping never allocates (nor
 /// copies a state on the usual path) and a failed step leaves the last good state untouched.
+///
+/// ```
+/// # use mechgen_runtime::mechanism;
+/// # mechanism! {
+/// #     /// A slider-crank (mm, rad, s).
+/// #     pub mechanism SliderCrank {
+/// #         param omega = 10.0;
+/// #         ground frame at (0, 0, 0);
+/// #         body crank near (0, 0, 0.5);
+/// #         body rod near (35, 19, -0.19);
+/// #         body slider near (133, 0, 0);
+/// #         joint pivot: revolute(frame, crank);
+/// #         joint crank_pin: revolute(crank @ (40, 0), rod);
+/// #         joint wrist: revolute(rod @ (100, 0), slider);
+/// #         joint guide: prismatic(frame, slider, along (1, 0));
+/// #         driver turn: angle(crank) = 0.5 + omega * t;
+/// #     }
+/// # }
+/// use mechgen_runtime::{Simulation, Solver};
+///
+/// let mut simulation = Simulation::new(Solver::new(SliderCrank::default()), 0.0)?;
+/// // A revolution of the crank in 100 steps, visiting every state.
+/// let period = core::f64::consts::TAU / 10.0;
+/// let mut top = f64::MIN;
+/// simulation.run(period, 100, |state| top = top.max(state.slider().x))?;
+/// // The slider's furthest position: crank and rod in line.
+/// assert!((top - 140.0).abs() < 0.1);
+/// # Ok::<(), mechgen_runtime::SolveError>(())
+/// ```
 pub struct Simulation<M: Structured>
 where
     DefaultAllocator: Storage<M::Dim>,

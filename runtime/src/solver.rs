@@ -23,6 +23,36 @@ use crate::workspace::{Parts, Workspace};
 /// relative to `max(1, ‖D_c⁻¹ q_b‖∞)` over the coordinates of the block being solved (so a
 /// coupler that has turned a million radians is still resolved to round-off). The same options
 /// then suit a micro-mechanism in metres and an engine in millimetres.
+///
+/// ```
+/// # use mechgen_runtime::mechanism;
+/// # mechanism! {
+/// #     /// A slider-crank (mm, rad, s).
+/// #     pub mechanism SliderCrank {
+/// #         param omega = 10.0;
+/// #         ground frame at (0, 0, 0);
+/// #         body crank near (0, 0, 0.5);
+/// #         body rod near (35, 19, -0.19);
+/// #         body slider near (133, 0, 0);
+/// #         joint pivot: revolute(frame, crank);
+/// #         joint crank_pin: revolute(crank @ (40, 0), rod);
+/// #         joint wrist: revolute(rod @ (100, 0), slider);
+/// #         joint guide: prismatic(frame, slider, along (1, 0));
+/// #         driver turn: angle(crank) = 0.5 + omega * t;
+/// #     }
+/// # }
+/// use mechgen_runtime::{Simulation, Solver, SolverOptions};
+///
+/// // Tighter than the default, and without the condition estimate (a little faster).
+/// let options = SolverOptions {
+///     residual_tolerance: 1e-13,
+///     estimate_condition: false,
+///     ..SolverOptions::default()
+/// };
+/// let simulation = Simulation::new(Solver::with_options(SliderCrank::default(), options), 0.0)?;
+/// assert!(simulation.state().condition.is_nan());
+/// # Ok::<(), mechgen_runtime::SolveError>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverOptions {
     /// A first Newton correction ends the iteration only from a point whose scaled residual
@@ -159,6 +189,38 @@ impl Convergence {
 ///
 /// All storage is created by [`Solver::new`]: the scene's [`Structured::Workspace`], sized by
 /// its largest block. Solves never allocate, error paths included.
+///
+/// One instant, from the scene's guess:
+///
+/// ```
+/// # use mechgen_runtime::mechanism;
+/// # mechanism! {
+/// #     /// A slider-crank (mm, rad, s).
+/// #     pub mechanism SliderCrank {
+/// #         param omega = 10.0;
+/// #         ground frame at (0, 0, 0);
+/// #         body crank near (0, 0, 0.5);
+/// #         body rod near (35, 19, -0.19);
+/// #         body slider near (133, 0, 0);
+/// #         joint pivot: revolute(frame, crank);
+/// #         joint crank_pin: revolute(crank @ (40, 0), rod);
+/// #         joint wrist: revolute(rod @ (100, 0), slider);
+/// #         joint guide: prismatic(frame, slider, along (1, 0));
+/// #         driver turn: angle(crank) = 0.5 + omega * t;
+/// #     }
+/// # }
+/// use mechgen_runtime::{Mechanism, Solver, Vector, nalgebra::Const};
+///
+/// let mut solver = Solver::new(SliderCrank::default());
+/// let mut guess = Vector::<Const<12>>::zeros();
+/// solver.mechanism().initial_guess(&mut guess);
+/// let state = solver.solve(0.05, &guess)?;
+/// // q is in declaration order: frame, crank, rod, slider (x, y, θ each).
+/// assert!((state.q[SliderCrank::CRANK_THETA] - 1.0).abs() < 1e-12);
+/// let slider_speed = state.qd()[SliderCrank::SLIDER_X];
+/// assert!(slider_speed < 0.0);
+/// # Ok::<(), mechgen_runtime::SolveError>(())
+/// ```
 pub struct Solver<M: Structured>
 where
     DefaultAllocator: Storage<M::Dim>,

@@ -13,6 +13,39 @@ use crate::mechanism::{Accelerations, Mechanism, Outputs, Storage, Vector, Veloc
 /// such as `state.piston()` for its own scene only, and so that [`State::qd`] and
 /// [`State::qdd`] exist only for scenes that compute velocities and accelerations: reading an
 /// output the scene left out is a compile error.
+///
+/// ```
+/// # use mechgen_runtime::mechanism;
+/// # mechanism! {
+/// #     /// A slider-crank (mm, rad, s).
+/// #     pub mechanism SliderCrank {
+/// #         param omega = 10.0;
+/// #         ground frame at (0, 0, 0);
+/// #         body crank near (0, 0, 0.5);
+/// #         body rod near (35, 19, -0.19);
+/// #         body slider near (133, 0, 0);
+/// #         joint pivot: revolute(frame, crank);
+/// #         joint crank_pin: revolute(crank @ (40, 0), rod);
+/// #         joint wrist: revolute(rod @ (100, 0), slider);
+/// #         joint guide: prismatic(frame, slider, along (1, 0));
+/// #         driver turn: angle(crank) = 0.5 + omega * t;
+/// #     }
+/// # }
+/// use mechgen_runtime::{Simulation, Solver, write_csv_header};
+///
+/// let simulation = Simulation::new(Solver::new(SliderCrank::default()), 0.0)?;
+/// let state = simulation.state();
+/// // Named access through the scene's generated trait, or by index.
+/// let rod = state.rod();
+/// assert_eq!(rod.theta, state.q[SliderCrank::ROD_THETA]);
+/// assert_eq!(rod.theta_dot, state.qd()[SliderCrank::ROD_THETA]);
+/// // One CSV row without a heap (any `core::fmt::Write`).
+/// let mut csv = String::new();
+/// write_csv_header(simulation.solver().mechanism(), &mut csv).unwrap();
+/// state.write_csv_row(&mut csv).unwrap();
+/// assert!(csv.starts_with("t,frame.x,"));
+/// # Ok::<(), mechgen_runtime::SolveError>(())
+/// ```
 pub struct State<M: Mechanism>
 where
     DefaultAllocator: Storage<M::Dim>,

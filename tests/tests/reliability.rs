@@ -325,7 +325,10 @@ fn parameter_errors_name_the_parameter_and_list_the_declared_ones() {
         text.contains("no parameter `omgea`") && text.contains("declared: `omega`"),
         "{text}"
     );
-    let text = generated.set_parameter("omega", f64::NAN).unwrap_err().to_string();
+    let text = generated
+        .set_parameter("omega", f64::NAN)
+        .unwrap_err()
+        .to_string();
     assert!(text.contains("`omega` must be a finite number"), "{text}");
 
     let mut by_tape = interpreted(SEED).unwrap();

@@ -630,10 +630,12 @@ where
         value: f64,
     ) -> Result<(), ParameterError<'a>> {
         // The copy first: the inner error borrows the inner mechanism for as long as it lives.
-        let index = (0..self.inner.parameter_count())
-            .find(|&k| self.inner.parameter_name(k) == Some(name));
-        if let (Some(slot), true) = (index.and_then(|k| self.params.get_mut(k)), value.is_finite())
-        {
+        let index =
+            (0..self.inner.parameter_count()).find(|&k| self.inner.parameter_name(k) == Some(name));
+        if let (Some(slot), true) = (
+            index.and_then(|k| self.params.get_mut(k)),
+            value.is_finite(),
+        ) {
             *slot = value;
         }
         self.inner.set_parameter(name, value)
