@@ -7,6 +7,8 @@ use std::path::PathBuf;
 
 use clap::{ArgGroup, Args, CommandFactory, Parser, Subcommand};
 
+use crate::solve::Format;
+
 /// Exit status text shared by every help page.
 const EXIT_STATUS: &str = "\
 FILE may be `-` to read the scene from standard input.
@@ -54,9 +56,12 @@ enum Sub {
         /// The scene (a .mech file, or `-` for standard input)
         #[arg(value_name = "FILE")]
         file: PathBuf,
-        /// Also print the operation counts of each generated function
+        /// Also print the operation counts of each generated function (text only)
         #[arg(long)]
         stats: bool,
+        /// Output format: the readable report, or JSON (the same facts, schema in the README)
+        #[arg(long, value_enum, default_value_t = CheckFormat::Text)]
+        format: CheckFormat,
     },
     /// Solve positions, velocities and accelerations over time with the interpreter and the
     /// runtime solver, and write them as CSV (columns t, then q, q_dot, q_ddot of every
@@ -98,9 +103,12 @@ struct SolveFlags {
     /// Override a parameter's default (repeatable; `mechgen check FILE` lists them)
     #[arg(long = "set", value_name = "NAME=VALUE", value_parser = set_value)]
     sets: Vec<(String, f64)>,
-    /// Write the CSV to OUT instead of standard output (`-`: standard output)
-    #[arg(long, value_name = "OUT")]
-    csv: Option<PathBuf>,
+    /// Write the results to OUT instead of standard output (`-`: standard output)
+    #[arg(long, value_name = "OUT", visible_alias = "csv")]
+    out: Option<PathBuf>,
+    /// Output format
+    #[arg(long, value_enum, default_value_t = Format::Csv)]
+    format: Format,
     /// Add per-step columns: Newton iterations, sub-steps, evaluations, static-pivot
     /// fallbacks, condition estimate and the sign of det Φ_q
     #[arg(long)]
@@ -121,6 +129,8 @@ pub enum Command {
         input: Input,
         /// Also print operation counts of the generated functions.
         stats: bool,
+        /// Text report or JSON.
+        format: CheckFormat,
     },
     /// Solve a scene over time and write CSV.
     Solve(SolveArgs),
@@ -137,10 +147,20 @@ pub enum Input {
     File(PathBuf),
 }
 
-/// Where the CSV goes.
+/// How `check` writes its report.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum CheckFormat {
+    /// The readable report.
+    #[default]
+    Text,
+    /// [`crate::inspect::Summary`] as JSON.
+    Json,
+}
+
+/// Where the results go.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Output {
-    /// Standard output (no `--csv`, or `--csv -`).
+    /// Standard output (no `--out`, or `--out -`).
     Stdout,
     /// A file, created or truncated.
     File(PathBuf),
@@ -175,8 +195,10 @@ pub struct SolveArgs {
     /// Parameter overrides in command-line order: names are checked against the scene later,
     /// so that the error can list the parameters it declares.
     pub sets: Vec<(String, f64)>,
-    /// Where the CSV goes.
-    pub csv: Output,
+    /// Where the results go.
+    pub out: Output,
+    /// CSV or JSON.
+    pub format: Format,
     /// Whether to add the per-step diagnostic columns.
     pub diagnostics: bool,
 }
@@ -191,9 +213,14 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<Command, clap::
     let cli = Cli::try_parse_from(program.chain(args))?;
     Ok(match cli.command {
         Sub::Expand { file } => Command::Expand { input: input(file) },
-        Sub::Check { file, stats } => Command::Check {
+        Sub::Check {
+            file,
+            stats,
+            format,
+        } => Command::Check {
             input: input(file),
             stats,
+            format,
         },
         Sub::Completions { shell } => Command::Completions(shell),
         Sub::Solve(flags) => Command::Solve(solve_args(flags)?),
@@ -239,12 +266,12 @@ fn solve_args(flags: SolveFlags) -> Result<SolveArgs, clap::Error> {
             )));
         }
     }
-    let csv = match flags.csv {
+    let out = match flags.out {
         None => Output::Stdout,
         Some(path) if path.as_os_str() == "-" => Output::Stdout,
         Some(path) if path.as_os_str().is_empty() => {
             return Err(invalid(
-                "`--csv` needs a file name (or `-` for standard output)".to_owned(),
+                "`--out` needs a file name (or `-` for standard output)".to_owned(),
             ));
         }
         Some(path) => Output::File(path),
@@ -253,7 +280,8 @@ fn solve_args(flags: SolveFlags) -> Result<SolveArgs, clap::Error> {
         input: input(flags.file),
         times,
         sets: flags.sets,
-        csv,
+        out,
+        format: flags.format,
         diagnostics: flags.diagnostics,
     })
 }
@@ -378,7 +406,8 @@ mod tests {
                 steps: 10,
             },
             sets: vec![("omega".into(), 2.0), ("l".into(), 300.0)],
-            csv: Output::File("out.csv".into()),
+            out: Output::File("out.csv".into()),
+            format: Format::Csv,
             diagnostics: true,
         };
         assert_eq!(command.unwrap(), Command::Solve(expected));
@@ -401,7 +430,7 @@ mod tests {
             args.times,
             Times::Listed(vec![-1.0, 0.1, 0.30000000000000004])
         );
-        assert_eq!((args.input, args.csv), (Input::Stdin, Output::Stdout));
+        assert_eq!((args.input, args.out), (Input::Stdin, Output::Stdout));
         assert!(!args.diagnostics);
         let Ok(Command::Solve(args)) = parse_strs(&["solve", "s", "--times", "t.txt"]) else {
             panic!("parses");

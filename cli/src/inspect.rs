@@ -7,35 +7,64 @@ use core::fmt::{self, Write};
 
 use mechgen::Scene;
 use mechgen::model::ConstraintKind;
+use serde::Serialize;
 
-/// The `check` report for a scene read from `file`.
-pub fn report(scene: &Scene, file: &str, stats: bool) -> String {
-    let mut out = String::new();
-    // Writing to a String cannot fail.
-    let _ = write_report(&mut out, scene, file, stats);
-    out
+/// What `check` reports about a scene, rendered as text ([`report`]) or JSON ([`json`]; the
+/// schema is this structure, field for field).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// The mechanism's name.
+    pub mechanism: String,
+    /// Where it was read from.
+    pub file: String,
+    /// Moving bodies.
+    pub moving_bodies: usize,
+    /// Ground (fixed) bodies.
+    pub ground_bodies: usize,
+    /// Joints, drivers and ground constraints.
+    pub constraints: usize,
+    /// Coordinate names in q order (`piston.x`).
+    pub coordinates: Vec<String>,
+    /// Equation names in Φ order (`crank_pin.x`).
+    pub equations: Vec<String>,
+    /// Degrees of freedom by Gruebler's count: 3 × moving bodies − joint equations.
+    pub degrees_of_freedom: i64,
+    /// Joint equations in that count.
+    pub joint_equations: usize,
+    /// Drivers (equal to the degrees of freedom in a valid scene).
+    pub drivers: usize,
+    /// Structural non-zeros of Φ_q.
+    pub jacobian_nonzeros: usize,
+    /// The scene's length scale, with the parameters' defaults.
+    pub length_scale: f64,
+    /// Parameters with their defaults, in declaration order.
+    pub parameters: Vec<Parameter>,
+    /// Branch invariants as written.
+    pub branches: Vec<Branch>,
 }
 
-fn write_report(out: &mut String, scene: &Scene, file: &str, stats: bool) -> fmt::Result {
+/// A parameter and its default.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Parameter {
+    /// Its name.
+    pub name: String,
+    /// Its default value.
+    pub default: f64,
+}
+
+/// A branch invariant.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Branch {
+    /// Its name.
+    pub name: String,
+    /// The invariant, as the spec writes it.
+    pub invariant: String,
+}
+
+/// The facts `check` reports about `scene`, read from `file`.
+pub fn summary(scene: &Scene, file: &str) -> Summary {
     let model = &scene.model;
-    let n = model.dim();
     let moving = model.bodies.iter().filter(|b| !b.ground).count();
-    let ground = model.bodies.len() - moving;
-    writeln!(
-        out,
-        "mechanism {} ({file}): {} bodies ({moving} moving, {ground} ground), {} constraints",
-        model.name,
-        model.bodies.len(),
-        model.constraints.len()
-    )?;
-
-    let coordinates = model.coordinate_names();
-    writeln!(out, "\ncoordinates ({}):", coordinates.len())?;
-    numbered(out, &coordinates)?;
-    let equations = model.equation_names();
-    writeln!(out, "\nequations ({}):", equations.len())?;
-    numbered(out, &equations)?;
-
     let joint_equations: usize = model
         .constraints
         .iter()
@@ -49,9 +78,79 @@ fn write_report(out: &mut String, scene: &Scene, file: &str, stats: bool) -> fmt
         })
         .map(|c| c.kind.equation_suffixes().len())
         .sum();
-    // Signed: an inconsistent model would go negative (check rejects those, but say it right).
-    let dof = 3 * moving as i64 - joint_equations as i64;
-    let drivers = model.driver_count();
+    let env = mechgen::interpret::Env {
+        params: model.params.iter().map(|p| p.default).collect(),
+        ..Default::default()
+    };
+    let scale = &scene.kinematics.length_scale;
+    let dependent: Vec<f64> = scale
+        .dependent
+        .iter()
+        .map(|&id| mechgen::interpret::eval(&model.arena, id, &env))
+        .collect();
+    Summary {
+        mechanism: model.name.to_string(),
+        file: file.to_owned(),
+        moving_bodies: moving,
+        ground_bodies: model.bodies.len() - moving,
+        constraints: model.constraints.len(),
+        coordinates: model.coordinate_names(),
+        equations: model.equation_names(),
+        // Signed: an inconsistent model would go negative (check rejects those).
+        degrees_of_freedom: 3 * moving as i64 - joint_equations as i64,
+        joint_equations,
+        drivers: model.driver_count(),
+        jacobian_nonzeros: scene.kinematics.jacobian.len(),
+        length_scale: scale.evaluate(&dependent),
+        parameters: model
+            .params
+            .iter()
+            .map(|p| Parameter {
+                name: p.name.to_string(),
+                default: p.default,
+            })
+            .collect(),
+        branches: model
+            .branches
+            .iter()
+            .map(|b| Branch {
+                name: b.name.clone(),
+                invariant: model.describe_branch(b),
+            })
+            .collect(),
+    }
+}
+
+/// The [`Summary`] as pretty-printed JSON.
+pub fn json(scene: &Scene, file: &str) -> String {
+    // Plain data (strings, numbers, vectors) always serialises.
+    serde_json::to_string_pretty(&summary(scene, file)).unwrap_or_default() + "\n"
+}
+
+/// The `check` report for a scene read from `file`.
+pub fn report(scene: &Scene, file: &str, stats: bool) -> String {
+    let mut out = String::new();
+    // Writing to a String cannot fail.
+    let _ = write_report(&mut out, scene, &summary(scene, file), stats);
+    out
+}
+
+fn write_report(out: &mut String, scene: &Scene, s: &Summary, stats: bool) -> fmt::Result {
+    let (moving, ground) = (s.moving_bodies, s.ground_bodies);
+    writeln!(
+        out,
+        "mechanism {} ({}): {} bodies ({moving} moving, {ground} ground), {} constraints",
+        s.mechanism,
+        s.file,
+        moving + ground,
+        s.constraints
+    )?;
+    writeln!(out, "\ncoordinates ({}):", s.coordinates.len())?;
+    numbered(out, &s.coordinates)?;
+    writeln!(out, "\nequations ({}):", s.equations.len())?;
+    numbered(out, &s.equations)?;
+
+    let (dof, joint_equations, drivers) = (s.degrees_of_freedom, s.joint_equations, s.drivers);
     let verdict = if dof == drivers as i64 {
         "matched by"
     } else {
@@ -67,8 +166,8 @@ fn write_report(out: &mut String, scene: &Scene, file: &str, stats: bool) -> fmt
         plural(drivers)
     )?;
 
-    let nonzeros = scene.kinematics.jacobian.len();
-    let total = n * n;
+    let n = s.coordinates.len();
+    let (nonzeros, total) = (s.jacobian_nonzeros, n * n);
     let percent = if total == 0 {
         0.0
     } else {
@@ -78,43 +177,37 @@ fn write_report(out: &mut String, scene: &Scene, file: &str, stats: bool) -> fmt
         out,
         "Jacobian Φ_q: {nonzeros} structural non-zeros of {total} ({n} × {n}), {percent:.1}% dense"
     )?;
-
-    let env = mechgen::interpret::Env {
-        params: model.params.iter().map(|p| p.default).collect(),
-        ..Default::default()
-    };
-    let scale = &scene.kinematics.length_scale;
-    let dependent: Vec<f64> = scale
-        .dependent
-        .iter()
-        .map(|&id| mechgen::interpret::eval(&model.arena, id, &env))
-        .collect();
     writeln!(
         out,
         "length scale: {} (largest geometric length{})",
-        scale.evaluate(&dependent),
-        if dependent.is_empty() {
+        s.length_scale,
+        if scene.kinematics.length_scale.dependent.is_empty() {
             ""
         } else {
             ", with the parameters' defaults"
         }
     )?;
 
-    if model.params.is_empty() {
+    if s.parameters.is_empty() {
         writeln!(out, "\nparameters: none")?;
     } else {
-        writeln!(out, "\nparameters ({}):", model.params.len())?;
-        let width = model.params.iter().map(|p| p.name.to_string().len()).max();
-        for p in &model.params {
-            let name = p.name.to_string();
-            writeln!(out, "  {name:<w$} = {}", p.default, w = width.unwrap_or(0))?;
+        writeln!(out, "\nparameters ({}):", s.parameters.len())?;
+        let width = s.parameters.iter().map(|p| p.name.len()).max();
+        for p in &s.parameters {
+            writeln!(
+                out,
+                "  {:<w$} = {}",
+                p.name,
+                p.default,
+                w = width.unwrap_or(0)
+            )?;
         }
     }
 
-    if !model.branches.is_empty() {
-        writeln!(out, "\nbranch invariants ({}):", model.branches.len())?;
-        for b in &model.branches {
-            writeln!(out, "  {}: {}", b.name, model.describe_branch(b))?;
+    if !s.branches.is_empty() {
+        writeln!(out, "\nbranch invariants ({}):", s.branches.len())?;
+        for b in &s.branches {
+            writeln!(out, "  {}: {}", b.name, b.invariant)?;
         }
     }
 
@@ -199,5 +292,20 @@ mod tests {
         assert_eq!(counts[2].outputs, counts[0].outputs + nonzeros);
         // sin θ and cos θ of the rod, shared.
         assert_eq!(counts[0].counts.trig, 3, "{:?}", counts[0]);
+    }
+
+    #[test]
+    fn json_holds_the_same_facts() {
+        let scene = mechgen::compile_str(SCENE).expect("compiles");
+        let value: serde_json::Value = serde_json::from_str(&json(&scene, "p.mech")).unwrap();
+        assert_eq!(value["mechanism"], "Pendulum");
+        assert_eq!(value["coordinates"][0], "frame.x");
+        assert_eq!(value["equations"].as_array().map(Vec::len), Some(6));
+        assert_eq!(value["degrees_of_freedom"], 1);
+        assert_eq!(value["drivers"], 1);
+        assert_eq!(value["parameters"][0]["name"], "l");
+        assert_eq!(value["parameters"][0]["default"], 2.0);
+        assert_eq!(value["length_scale"], 2.0);
+        assert_eq!(value["branches"][0]["name"], "hanging");
     }
 }

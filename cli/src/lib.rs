@@ -88,10 +88,18 @@ fn execute(
                 .map_err(|errors| compile_failure(&source, &errors))?;
             print(stdout, &code)
         }
-        Command::Check { input, stats } => {
+        Command::Check {
+            input,
+            stats,
+            format,
+        } => {
             let source = read_source(&input)?;
             let scene = compile(&source)?;
-            print(stdout, &inspect::report(&scene, &source.name, stats))
+            let text = match format {
+                args::CheckFormat::Text => inspect::report(&scene, &source.name, stats),
+                args::CheckFormat::Json => inspect::json(&scene, &source.name),
+            };
+            print(stdout, &text)
         }
         Command::Solve(args) => solve(&args, stdout, stderr),
     }
@@ -177,7 +185,7 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     let mut simulation = solve::assemble(mechanism, t0).map_err(failed)?;
 
     let mut file;
-    let (out, destination): (&mut dyn Write, String) = match &args.csv {
+    let (out, destination): (&mut dyn Write, String) = match &args.out {
         Output::Stdout => (stdout, "stdout".to_owned()),
         Output::File(path) => {
             refuse_to_overwrite_input(&args.input, path)?;
@@ -197,6 +205,7 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
             solve::run(
                 &mut simulation,
                 (1..steps + 1).map(|k| sample_time(t0, t_end, steps, k)),
+                args.format,
                 args.diagnostics,
                 out,
             ),
@@ -210,7 +219,7 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
             );
             let rest = listed[1..].iter().copied();
             (
-                solve::run(&mut simulation, rest, args.diagnostics, out),
+                solve::run(&mut simulation, rest, args.format, args.diagnostics, out),
                 range,
             )
         }
@@ -261,14 +270,14 @@ fn readable(x: f64) -> String {
     }
 }
 
-fn refuse_to_overwrite_input(input: &Input, csv: &Path) -> Result<(), Failure> {
+fn refuse_to_overwrite_input(input: &Input, out: &Path) -> Result<(), Failure> {
     let Input::File(scene) = input else {
         return Ok(());
     };
-    match (scene.canonicalize(), csv.canonicalize()) {
+    match (scene.canonicalize(), out.canonicalize()) {
         (Ok(a), Ok(b)) if a == b => Err(failed(format_args!(
-            "`--csv {}` would overwrite the scene itself: give another file name",
-            csv.display()
+            "`--out {}` would overwrite the scene itself: give another file name",
+            out.display()
         ))),
         _ => Ok(()),
     }

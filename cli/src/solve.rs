@@ -151,44 +151,128 @@ fn step_hint(error: &SolveError) -> &'static str {
 /// The per-step diagnostic columns of `--diagnostics`, after the kinematic ones.
 pub const DIAGNOSTIC_COLUMNS: &str = "iterations,substeps,evaluations,fallbacks,condition,det_sign";
 
-/// Writes the CSV header and one row per time: the assembled state (at its own time), then a
-/// step to each of `times`, flushing `out` even when a solve fails. With `diagnostics`, each
-/// row ends with the [`DIAGNOSTIC_COLUMNS`] of its solve.
+/// How `solve` writes its results.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum Format {
+    /// A header line, then one line per time: `t`, q, q_dot, q_ddot (and with `--diagnostics`
+    /// the [`DIAGNOSTIC_COLUMNS`]).
+    #[default]
+    Csv,
+    /// One JSON document: `{"mechanism", "coordinates", "outputs", "states": [State…],
+    /// "error"}`, each state as the runtime serialises it (`t`, `q`, `q_dot`, `q_ddot`,
+    /// `iterations`, `evaluations`, `substeps`, `condition`, `fallbacks`, `det_sign`), and
+    /// `error` `null` or `{"step", "message", "kind"}`. Written as the run goes, so a failed
+    /// run still leaves a complete document.
+    Json,
+}
+
+/// Writes one run's rows in a [`Format`].
+struct Rows<'a> {
+    format: Format,
+    diagnostics: bool,
+    out: &'a mut dyn Write,
+    line: String,
+    rows: usize,
+}
+
+impl Rows<'_> {
+    fn start(&mut self, m: &Interpreted) -> std::io::Result<()> {
+        self.line.clear();
+        match self.format {
+            Format::Csv => {
+                // Writing to a String cannot fail.
+                let _ = write_csv_header(m, &mut self.line);
+                if self.diagnostics {
+                    self.line.pop();
+                    self.line.push(',');
+                    self.line.push_str(DIAGNOSTIC_COLUMNS);
+                    self.line.push('\n');
+                }
+            }
+            Format::Json => {
+                let coordinates: Vec<&str> =
+                    (0..m.len()).filter_map(|i| m.coordinate_name(i)).collect();
+                let head = serde_json::json!({
+                    "mechanism": m.name(),
+                    "coordinates": coordinates,
+                    "outputs": m.outputs(),
+                });
+                let head = head.to_string();
+                // `{…}` without its closing brace, then the states array.
+                self.line.push_str(&head[..head.len() - 1]);
+                self.line.push_str(",\"states\":[\n");
+            }
+        }
+        self.out.write_all(self.line.as_bytes())
+    }
+
+    fn row(&mut self, state: &State<Interpreted>) -> std::io::Result<()> {
+        self.line.clear();
+        match self.format {
+            Format::Csv => {
+                let _ = state.write_csv_row(&mut self.line);
+                if self.diagnostics {
+                    self.line.pop();
+                    let _ = write_diagnostics(state, &mut self.line);
+                }
+            }
+            Format::Json => {
+                if self.rows > 0 {
+                    self.line.push_str(",\n");
+                }
+                // A state is numbers and arrays of numbers: it always serialises.
+                self.line
+                    .push_str(&serde_json::to_string(state).unwrap_or_default());
+            }
+        }
+        self.rows += 1;
+        self.out.write_all(self.line.as_bytes())
+    }
+
+    /// Ends the document (JSON), with the error that stopped the run at `step`, if any.
+    fn finish(&mut self, failure: Option<(usize, &SolveError, &str)>) -> std::io::Result<()> {
+        if self.format == Format::Json {
+            let error = failure.map(|(step, kind, message)| {
+                serde_json::json!({ "step": step, "message": message, "kind": kind })
+            });
+            let tail = format!("\n],\"error\":{}}}\n", serde_json::json!(error));
+            self.out.write_all(tail.as_bytes())?;
+        }
+        self.out.flush()
+    }
+}
+
+/// Writes the header and one row per time: the assembled state (at its own time), then a step
+/// to each of `times`, ending the output even when a solve fails. With `diagnostics`, each
+/// CSV row ends with the [`DIAGNOSTIC_COLUMNS`] of its solve (JSON states always carry them).
 ///
 /// # Errors
 /// [`RunError::Write`] when `out` fails, [`RunError::Solve`] when a step does.
 pub fn run(
     simulation: &mut Simulation<Interpreted>,
     times: impl ExactSizeIterator<Item = f64>,
+    format: Format,
     diagnostics: bool,
     out: &mut dyn Write,
 ) -> Result<Summary, RunError> {
-    let mut line = String::new();
-    // Writing to a String cannot fail.
-    let _ = write_csv_header(simulation.solver().mechanism(), &mut line);
-    if diagnostics {
-        line.pop();
-        line.push(',');
-        line.push_str(DIAGNOSTIC_COLUMNS);
-        line.push('\n');
-    }
-    out.write_all(line.as_bytes()).map_err(RunError::Write)?;
-
+    let mut rows = Rows {
+        format,
+        diagnostics,
+        out,
+        line: String::new(),
+        rows: 0,
+    };
+    rows.start(simulation.solver().mechanism())
+        .map_err(RunError::Write)?;
     let dim = simulation.solver().mechanism().len();
     let mut phi = DVector::zeros(dim);
     let mut summary = Summary::default();
     let mut record = |simulation: &Simulation<Interpreted>,
-                      out: &mut dyn Write,
+                      rows: &mut Rows<'_>,
                       summary: &mut Summary|
      -> Result<(), RunError> {
-        let state: &State<Interpreted> = simulation.state();
-        line.clear();
-        let _ = state.write_csv_row(&mut line);
-        if diagnostics {
-            line.pop();
-            let _ = write_diagnostics(state, &mut line);
-        }
-        out.write_all(line.as_bytes()).map_err(RunError::Write)?;
+        let state = simulation.state();
+        rows.row(state).map_err(RunError::Write)?;
         // The state does not keep the solver's residual; Φ at the returned q is that residual.
         simulation
             .solver()
@@ -200,21 +284,22 @@ pub fn run(
         Ok(())
     };
 
-    record(simulation, out, &mut summary)?;
+    record(simulation, &mut rows, &mut summary)?;
     let steps = times.len();
     for (k, t) in (1..).zip(times) {
         if let Err(error) = simulation.step_to(t) {
-            out.flush().map_err(RunError::Write)?;
             let message = format!(
                 "solve failed at step {k} of {steps}: {}\n  hint: {}",
                 error.describe(simulation.solver().mechanism()),
                 step_hint(&error)
             );
+            rows.finish(Some((k, &error, &message)))
+                .map_err(RunError::Write)?;
             return Err(RunError::Solve { message, summary });
         }
-        record(simulation, out, &mut summary)?;
+        record(simulation, &mut rows, &mut summary)?;
     }
-    out.flush().map_err(RunError::Write)?;
+    rows.finish(None).map_err(RunError::Write)?;
     Ok(summary)
 }
 

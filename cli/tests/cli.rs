@@ -441,3 +441,83 @@ fn diagnostics_add_per_step_columns() {
         assert!(sign == 1 || sign == -1, "{row:?}");
     }
 }
+
+#[test]
+fn json_output_is_one_document_even_when_a_step_fails() {
+    let seed = scene("piston_crank.mech");
+    let out = mechgen(&[
+        "solve", &seed, "--t-end", "0.01", "--steps", "2", "--format", "json",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let document: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(document["mechanism"], "PistonCrank");
+    assert_eq!(document["coordinates"][3], "piston.x");
+    assert_eq!(document["outputs"], "Accelerations");
+    assert!(document["error"].is_null());
+    let states = document["states"].as_array().unwrap();
+    assert_eq!(states.len(), 3);
+    assert_eq!(states[2]["t"], 0.01);
+    let piston_x = states[0]["q"][3].as_f64().unwrap();
+    assert!((piston_x - SEED_PISTON_X_AT_0).abs() < 1e-9, "{piston_x}");
+    // The same doubles as the CSV, bit for bit.
+    let csv = mechgen(&["solve", &seed, "--t-end", "0.01", "--steps", "2"]);
+    let (_, rows) = csv_rows(&csv);
+    for (state, row) in states.iter().zip(&rows) {
+        for (j, value) in state["q"].as_array().unwrap().iter().enumerate() {
+            let written: f64 = row[1 + j].parse().unwrap();
+            assert_eq!(value.as_f64().unwrap().to_bits(), written.to_bits());
+        }
+    }
+    for key in ["q_dot", "q_ddot", "iterations", "condition", "det_sign"] {
+        assert!(!states[1][key].is_null(), "{key}");
+    }
+
+    // A four-bar whose links lock at t ≈ 0.18: the states before, then the error.
+    let locked = scratch("locked.mech");
+    std::fs::write(
+        &locked,
+        "mechanism Locked {
+            ground frame at (0, 0, 0);
+            body crank near (0, 0, 0);
+            body coupler near (40, 0, 0.6);
+            body rocker near (60, 0, 1.1);
+            joint crank_pivot: revolute(frame, crank);
+            joint crank_pin: revolute(crank @ (40, 0), coupler);
+            joint rocker_pin: revolute(coupler @ (120, 0), rocker @ (80, 0));
+            joint rocker_pivot: revolute(rocker, frame @ (60, 0));
+            driver bend: relative_angle(crank, coupler) = 3 - 10 * t;
+        }",
+    )
+    .unwrap();
+    let path = locked.to_str().unwrap();
+    let out = mechgen(&[
+        "solve", path, "--t-end", "0.5", "--steps", "10", "--format", "json",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let document: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let error = &document["error"];
+    assert_eq!(error["step"], 4);
+    // Where the links lock: a dead point (Singular) or beyond it (NoAssembly), with its time.
+    let kind = error["kind"].as_object().unwrap();
+    let (variant, fields) = kind.iter().next().unwrap();
+    assert!(
+        variant == "Singular" || variant == "NoAssembly",
+        "{variant}"
+    );
+    let time = fields["time"].as_f64().unwrap();
+    assert!((0.15..0.2).contains(&time), "{time}");
+    assert!(
+        error["message"]
+            .as_str()
+            .unwrap()
+            .contains(&time.to_string())
+    );
+    assert_eq!(document["states"].as_array().unwrap().len(), 4);
+    let _ = std::fs::remove_file(&locked);
+
+    let out = mechgen(&["check", &seed, "--format", "json"]);
+    assert!(out.status.success());
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(summary["degrees_of_freedom"], 1);
+    assert_eq!(summary["parameters"][0]["name"], "omega");
+}

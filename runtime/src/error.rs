@@ -8,6 +8,7 @@ use crate::geometry::{GeometryFault, Requirement};
 use crate::mechanism::{Mechanism, Storage};
 
 /// The quantity found to be NaN or infinite.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Quantity {
     /// The time passed in.
@@ -104,6 +105,7 @@ impl fmt::Display for Quantity {
 /// // Named: "… largest in equation `elbow.x` …" (or another of the loop's equations).
 /// assert!(failure.to_string().contains("largest in equation `"));
 /// ```
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SolveError {
     /// Newton–Raphson hit the iteration cap while still reducing the residual.

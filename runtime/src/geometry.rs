@@ -13,6 +13,7 @@
 pub const MAX_LENGTH: f64 = 1e100;
 
 /// What a parameter-dependent geometric value must be.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Requirement {
     /// A body-fixed coordinate of a point or a ground position: finite, at most
@@ -52,6 +53,7 @@ impl Requirement {
 }
 
 /// A parameter-dependent geometric value that breaks its [`Requirement`].
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GeometryFault {
     /// The first equation of the joint (or driver) the value belongs to.

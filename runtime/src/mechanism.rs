@@ -97,6 +97,7 @@ impl core::error::Error for ParameterError<'_> {}
 /// Which kinematic outputs a scene computes: the spec's `outputs` line (default: all three).
 ///
 /// Ordered: each level includes the ones before it.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Outputs {
     /// Positions q only.
@@ -114,6 +115,7 @@ pub enum Outputs {
 /// its square, angles are left alone. A scene in metres and the same scene in millimetres then
 /// take the same Newton steps and report the same condition number. The discriminant is the
 /// power of length.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Unit {
     /// Radians (θ coordinates, angle drivers, a prismatic joint's relative angle).

@@ -53,6 +53,7 @@ use crate::workspace::{Parts, Workspace};
 /// assert!(simulation.state().condition.is_nan());
 /// # Ok::<(), mechgen_runtime::SolveError>(())
 /// ```
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SolverOptions {
     /// A first Newton correction ends the iteration only from a point whose scaled residual
@@ -125,6 +126,7 @@ impl Default for SolverOptions {
 }
 
 /// Outcome of a successful position solve, over all blocks.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Convergence {
     /// Updates applied by the block that needed the most (0 when every coordinate is explicit).

@@ -89,6 +89,7 @@ where
 }
 
 /// One body's pose.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pose {
     /// Reference point x.
@@ -100,6 +101,7 @@ pub struct Pose {
 }
 
 /// One body's pose and velocity.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PoseVelocity {
     /// Reference point x.
@@ -117,6 +119,7 @@ pub struct PoseVelocity {
 }
 
 /// One body's pose and its first two time derivatives.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyState {
     /// Reference point x.
@@ -348,6 +351,40 @@ where
             .field("orientation", &self.orientation)
             .field("outputs", &self.outputs)
             .finish()
+    }
+}
+
+/// `{"t", "q", "q_dot", "q_ddot", "iterations", "evaluations", "substeps", "condition",
+/// "fallbacks", "det_sign"}`, with `q_dot` and `q_ddot` only for scenes that compute them (as the
+/// CSV columns) and `condition` `null` when not estimated (serde_json writes NaN as `null`).
+#[cfg(feature = "serde")]
+impl<M: Mechanism> serde::Serialize for State<M>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let groups = column_groups(self.outputs);
+        let mut s = serializer.serialize_struct("State", 7 + groups)?;
+        s.serialize_field("t", &self.t)?;
+        s.serialize_field("q", self.q.as_slice())?;
+        if groups >= 2 {
+            s.serialize_field("q_dot", self.velocities.as_slice())?;
+        } else {
+            s.skip_field("q_dot")?;
+        }
+        if groups >= 3 {
+            s.serialize_field("q_ddot", self.accelerations.as_slice())?;
+        } else {
+            s.skip_field("q_ddot")?;
+        }
+        s.serialize_field("iterations", &self.iterations)?;
+        s.serialize_field("evaluations", &self.evaluations)?;
+        s.serialize_field("substeps", &self.substeps)?;
+        s.serialize_field("condition", &self.condition)?;
+        s.serialize_field("fallbacks", &self.fallbacks)?;
+        s.serialize_field("det_sign", &self.orientation)?;
+        s.end()
     }
 }
 
