@@ -2,7 +2,7 @@
 //! scene with one mistake (or, in `several_errors.rs`, several), and its `.stderr` holds the
 //! expected message and span.
 //!
-//! Regenerate the expectations with `TRYBUILD=overwrite cargo test -p mechgen-tests --test
+//! Regenerate the expectations with `TRYBUILD=overwrite cargo test -p mechgen-runtime --test
 //! compile_fail`, then read the diff: the caret must sit under the offending token.
 
 #[test]
