@@ -150,10 +150,10 @@ pub enum Input {
 /// How `check` writes its report.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum CheckFormat {
-    /// The readable report.
+    /// The readable report
     #[default]
     Text,
-    /// [`crate::inspect::Summary`] as JSON.
+    /// The same facts as one JSON object (see `inspect::Summary`)
     Json,
 }
 

@@ -151,18 +151,19 @@ fn step_hint(error: &SolveError) -> &'static str {
 /// The per-step diagnostic columns of `--diagnostics`, after the kinematic ones.
 pub const DIAGNOSTIC_COLUMNS: &str = "iterations,substeps,evaluations,fallbacks,condition,det_sign";
 
-/// How `solve` writes its results.
+/// How `solve` writes its results. CSV: a header line, then one line per time (`t`, q, q_dot,
+/// q_ddot, and with `--diagnostics` the [`DIAGNOSTIC_COLUMNS`]). JSON: one document,
+/// `{"mechanism", "coordinates", "outputs", "states": [State…], "error"}`, each state as the
+/// runtime serialises it (`t`, `q`, `q_dot`, `q_ddot`, `iterations`, `evaluations`,
+/// `substeps`, `condition`, `fallbacks`, `det_sign`), and `error` `null` or
+/// `{"step", "message", "kind"}`; written as the run goes, so a failed run still leaves a
+/// complete document. (The variants' docs are the CLI's help.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Format {
-    /// A header line, then one line per time: `t`, q, q_dot, q_ddot (and with `--diagnostics`
-    /// the [`DIAGNOSTIC_COLUMNS`]).
+    /// A header line, then one line per time
     #[default]
     Csv,
-    /// One JSON document: `{"mechanism", "coordinates", "outputs", "states": [State…],
-    /// "error"}`, each state as the runtime serialises it (`t`, `q`, `q_dot`, `q_ddot`,
-    /// `iterations`, `evaluations`, `substeps`, `condition`, `fallbacks`, `det_sign`), and
-    /// `error` `null` or `{"step", "message", "kind"}`. Written as the run goes, so a failed
-    /// run still leaves a complete document.
+    /// One JSON document with every state, and the error if a step fails
     Json,
 }
 

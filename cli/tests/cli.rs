@@ -473,23 +473,10 @@ fn json_output_is_one_document_even_when_a_step_fails() {
     }
 
     // A four-bar whose links lock at t ≈ 0.18: the states before, then the error.
-    let locked = scratch("locked.mech");
-    std::fs::write(
-        &locked,
-        "mechanism Locked {
-            ground frame at (0, 0, 0);
-            body crank near (0, 0, 0);
-            body coupler near (40, 0, 0.6);
-            body rocker near (60, 0, 1.1);
-            joint crank_pivot: revolute(frame, crank);
-            joint crank_pin: revolute(crank @ (40, 0), coupler);
-            joint rocker_pin: revolute(coupler @ (120, 0), rocker @ (80, 0));
-            joint rocker_pivot: revolute(rocker, frame @ (60, 0));
-            driver bend: relative_angle(crank, coupler) = 3 - 10 * t;
-        }",
-    )
-    .unwrap();
-    let path = locked.to_str().unwrap();
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/data/locked_four_bar.mech"
+    );
     let out = mechgen(&[
         "solve", path, "--t-end", "0.5", "--steps", "10", "--format", "json",
     ]);
@@ -513,7 +500,6 @@ fn json_output_is_one_document_even_when_a_step_fails() {
             .contains(&time.to_string())
     );
     assert_eq!(document["states"].as_array().unwrap().len(), 4);
-    let _ = std::fs::remove_file(&locked);
 
     let out = mechgen(&["check", &seed, "--format", "json"]);
     assert!(out.status.success());

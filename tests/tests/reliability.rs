@@ -287,22 +287,10 @@ fn assembly_far_from_the_guess_continues_in_time_from_where_the_guess_fits() {
 
 #[test]
 fn a_start_time_the_motion_cannot_reach_keeps_the_direct_error() {
-    // Links that lock (40 + 120 > 80 + 60, not Grashof): the relative angle cannot turn fully.
     // The mechanism assembles at t = 0 and locks at t ≈ 0.18, so neither the direct solve nor
     // the continuation from t = 0 reaches t0 = 5, and the direct solve's error comes back
     // after a bounded amount of work.
-    let source = "
-        pub mechanism Locked {
-            ground frame at (0, 0, 0);
-            body crank near (0, 0, 0);
-            body coupler near (40, 0, 0.6);
-            body rocker near (60, 0, 1.1);
-            joint crank_pivot: revolute(frame, crank);
-            joint crank_pin: revolute(crank @ (40, 0), coupler);
-            joint rocker_pin: revolute(coupler @ (120, 0), rocker @ (80, 0));
-            joint rocker_pivot: revolute(rocker, frame @ (60, 0));
-            driver bend: relative_angle(crank, coupler) = 3 - 10 * t;
-        }";
+    let source = include_str!("../data/locked_four_bar.mech");
     let mechanism = interpreted(source).unwrap();
     let failure = Simulation::new(Solver::new(mechanism.clone()), 5.0)
         .err()
