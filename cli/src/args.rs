@@ -65,7 +65,7 @@ enum Sub {
     },
     /// Solve positions, velocities and accelerations over time with the interpreter and the
     /// runtime solver, and write them as CSV (columns t, then q, q_dot, q_ddot of every
-    /// coordinate)
+    /// coordinate) or JSON
     #[command(after_help = format!("{TIMES_HELP}\n\n{EXIT_STATUS}"))]
     Solve(SolveFlags),
     /// Print a completion script for a shell (e.g. `mechgen completions bash > mechgen.bash`)
