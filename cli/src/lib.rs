@@ -169,20 +169,12 @@ fn compile_failure(source: &Source, errors: &mechgen::Errors) -> Failure {
 fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Result<(), Failure> {
     let source = read_source(&args.input)?;
     let scene = compile(&source)?;
-    let listed = match &args.times {
-        Times::Equal { .. } => Vec::new(),
-        Times::Listed(times) => times.clone(),
-        Times::File(path) => read_times(path)?,
-    };
-    let t0 = match args.times {
-        Times::Equal { t0, .. } => t0,
-        _ => listed[0],
-    };
+    let schedule = Schedule::resolve(&args.times)?;
     let mut mechanism = Interpreted::new(&scene);
     solve::apply_sets(&mut mechanism, &args.sets).map_err(failed)?;
     // Assemble before touching the output, so that a scene that cannot move leaves an existing
     // CSV file as it was.
-    let mut simulation = solve::assemble(mechanism, t0).map_err(failed)?;
+    let mut simulation = solve::assemble(mechanism, schedule.start()).map_err(failed)?;
 
     let mut file;
     let (out, destination): (&mut dyn Write, String) = match &args.out {
@@ -200,30 +192,14 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         }
     };
 
-    let (outcome, range) = match args.times {
-        Times::Equal { t0, t_end, steps } => (
-            solve::run(
-                &mut simulation,
-                (1..steps + 1).map(|k| sample_time(t0, t_end, steps, k)),
-                args.format,
-                args.diagnostics,
-                out,
-            ),
-            format!("t = {t0} to {t_end} in {}", count(steps, "equal step")),
-        ),
-        _ => {
-            let last = listed[listed.len() - 1];
-            let range = format!(
-                "{} from t = {t0} to {last}",
-                count(listed.len(), "listed time")
-            );
-            let rest = listed[1..].iter().copied();
-            (
-                solve::run(&mut simulation, rest, args.format, args.diagnostics, out),
-                range,
-            )
-        }
-    };
+    let outcome = solve::run(
+        &mut simulation,
+        schedule.after_start(),
+        args.format,
+        args.diagnostics,
+        out,
+    );
+    let range = schedule.describe();
     match outcome {
         Ok(summary) => {
             let _ = writeln!(
@@ -242,6 +218,57 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
             count(summary.rows, "row"),
             count(summary.iterations, "Newton iteration"),
         ))),
+    }
+}
+
+/// The sample times of a run, with a `--times` file read.
+enum Schedule {
+    /// `steps` equal steps from `t0` to `t_end` ([`sample_time`]).
+    Equal { t0: f64, t_end: f64, steps: usize },
+    /// Listed times, at least one, strictly increasing.
+    Listed(Vec<f64>),
+}
+
+impl Schedule {
+    fn resolve(times: &Times) -> Result<Self, Failure> {
+        Ok(match times {
+            &Times::Equal { t0, t_end, steps } => Schedule::Equal { t0, t_end, steps },
+            Times::Listed(times) => Schedule::Listed(times.clone()),
+            Times::File(path) => Schedule::Listed(read_times(path)?),
+        })
+    }
+
+    /// Where the mechanism is assembled.
+    fn start(&self) -> f64 {
+        match self {
+            Schedule::Equal { t0, .. } => *t0,
+            Schedule::Listed(times) => times.first().copied().unwrap_or(0.0),
+        }
+    }
+
+    /// The times stepped to after the start.
+    fn after_start(&self) -> Box<dyn ExactSizeIterator<Item = f64> + '_> {
+        match *self {
+            Schedule::Equal { t0, t_end, steps } => {
+                Box::new((1..steps + 1).map(move |k| sample_time(t0, t_end, steps, k)))
+            }
+            Schedule::Listed(ref times) => Box::new(times.iter().skip(1).copied()),
+        }
+    }
+
+    /// For the summary line: `t = 0 to 0.02 in 360 equal steps`.
+    fn describe(&self) -> String {
+        match self {
+            Schedule::Equal { t0, t_end, steps } => {
+                format!("t = {t0} to {t_end} in {}", count(*steps, "equal step"))
+            }
+            Schedule::Listed(times) => format!(
+                "{} from t = {} to {}",
+                count(times.len(), "listed time"),
+                self.start(),
+                times.last().copied().unwrap_or(0.0)
+            ),
+        }
     }
 }
 

@@ -544,26 +544,9 @@ impl Context<'_> {
         let body = if scale.dependent.is_empty() {
             constant
         } else {
-            let names: Vec<Ident> = (0..scale.dependent.len())
-                .map(|k| format_ident!("length{}", k))
-                .collect();
-            let outputs: Vec<(TokenStream, Id)> = names
-                .iter()
-                .zip(&scale.dependent)
-                .map(|(name, &id)| (quote!(let #name), id))
-                .collect();
-            let zero = names
-                .iter()
-                .zip(&scale.dependent)
-                .filter(|&(_, &id)| self.arena().is_zero(id))
-                .map(|(name, _)| quote! { let #name = 0.0f64; });
-            let zero: Vec<TokenStream> = zero.collect();
-            let evaluated = self
-                .function(&outputs, TokenStream::new(), &computed())
-                .body;
+            let (names, evaluated) = self.bind_locals("length", &scale.dependent);
             quote! {
                 #evaluated
-                #(#zero)*
                 let scale: f64 = #constant;
                 scale #(.max(#names.abs()))*
             }
@@ -576,6 +559,31 @@ impl Context<'_> {
         }
     }
 
+    /// Statements binding each of `ids` (expressions in parameters) to a local `{prefix}{k}`,
+    /// sharing sub-expressions, and the locals' names: what `length_scale` and `check_geometry`
+    /// evaluate with the current parameters.
+    fn bind_locals(&self, prefix: &str, ids: &[Id]) -> (Vec<Ident>, TokenStream) {
+        let names: Vec<Ident> = (0..ids.len())
+            .map(|k| format_ident!("{}{}", prefix, k))
+            .collect();
+        let outputs: Vec<(TokenStream, Id)> = names
+            .iter()
+            .zip(ids)
+            .map(|(name, &id)| (quote!(let #name), id))
+            .collect();
+        // The function body skips zero outputs; their locals are still read.
+        let zeros = names
+            .iter()
+            .zip(ids)
+            .filter(|&(_, &id)| self.arena().is_zero(id))
+            .map(|(name, _)| quote! { let #name = 0.0f64; });
+        let zeros: Vec<TokenStream> = zeros.collect();
+        let body = self
+            .function(&outputs, TokenStream::new(), &computed())
+            .body;
+        (names, quote! { #body #(#zeros)* })
+    }
+
     /// `check_geometry` for a scene with geometry written in parameters (the runtime's default,
     /// nothing to check, otherwise): each value evaluated with the current parameters and
     /// checked against its rule, in declaration order ([`crate::geometry`]).
@@ -584,23 +592,8 @@ impl Context<'_> {
         if checks.is_empty() {
             return TokenStream::new();
         }
-        let names: Vec<Ident> = (0..checks.len())
-            .map(|k| format_ident!("value{}", k))
-            .collect();
-        let outputs: Vec<(TokenStream, Id)> = names
-            .iter()
-            .zip(checks)
-            .map(|(name, c)| (quote!(let #name), c.value))
-            .collect();
-        let zero = names
-            .iter()
-            .zip(checks)
-            .filter(|&(_, c)| self.arena().is_zero(c.value))
-            .map(|(name, _)| quote! { let #name = 0.0f64; });
-        let zero: Vec<TokenStream> = zero.collect();
-        let evaluated = self
-            .function(&outputs, TokenStream::new(), &computed())
-            .body;
+        let values: Vec<Id> = checks.iter().map(|c| c.value).collect();
+        let (names, evaluated) = self.bind_locals("value", &values);
         let tests = names.iter().zip(checks).map(|(name, c)| {
             let requirement = format_ident!("{}", c.requirement.name());
             let (equation, parameter) = (idx(c.equation), idx(c.parameter));
@@ -625,7 +618,6 @@ impl Context<'_> {
                 &self,
             ) -> ::core::result::Result<(), ::mechgen_runtime::GeometryFault> {
                 #evaluated
-                #(#zero)*
                 #(#tests)*
                 ::core::result::Result::Ok(())
             }
