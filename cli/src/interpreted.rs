@@ -14,11 +14,12 @@ use mechgen::factor::Factorization;
 use mechgen::geometry;
 use mechgen::interpret::{Inputs, Tape};
 use mechgen::kinematics::LengthScale;
+use mechgen::reactions::ForceStage;
 use mechgen::structure::{self, Phase, Plan};
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{
-    Accelerations, Block, GeometryFault, Matrix, Mechanism, Outputs, ParameterError, Pattern,
-    Requirement, Stage, Structured, Unit, VecBuffers, Vector, Velocities,
+    Accelerations, Block, Forces, GeometryFault, Matrix, Mechanism, Outputs, ParameterError,
+    Pattern, Requirement, Stage, Structured, Unit, VecBuffers, Vector, Velocities,
 };
 
 /// A scene whose kinematics are interpreted rather than generated.
@@ -36,6 +37,10 @@ pub struct Interpreted {
     /// ν and γ, present when the scene asked for them.
     nu: Option<Tape>,
     gamma: Option<Tape>,
+    /// The force solve's textbook functions (F, and the reactions from λ), and the reactions'
+    /// names, present when the scene computes forces.
+    forces: Option<(Tape, Tape)>,
+    reaction_names: Vec<String>,
     outputs: Outputs,
     /// Structural non-zeros of Φ_q, in the order the Jacobian tape produces them.
     pattern: Vec<(usize, usize)>,
@@ -54,8 +59,8 @@ pub struct Interpreted {
     /// The solve plan, stage by stage, and the earlier stages each reads.
     stages: Vec<PlanStage>,
     reads: Vec<Vec<usize>>,
-    /// Workspace sizes: largest block, most value slots, trig cache.
-    largest: (usize, usize, usize),
+    /// Workspace sizes: largest block, most value slots, trig cache, force solve.
+    largest: (usize, usize, usize, usize),
     /// Tape slots and output values, reused by every call (evaluation is `&self`).
     scratch: RefCell<Scratch>,
     /// Block Jacobian evaluations so far: the unit of a solve's work, which fuzzing bounds.
@@ -72,6 +77,8 @@ enum PlanStage {
         levels: [Option<Tape>; 3],
         /// The sines and cosines the stage caches, and where.
         trig: Option<(Tape, Vec<usize>)>,
+        /// The multipliers of its equations (force solve).
+        multipliers: Option<Tape>,
     },
     Block {
         equations: Vec<usize>,
@@ -86,14 +93,25 @@ enum PlanStage {
         velocity_rhs: Option<Tape>,
         acceleration_rhs: Option<Tape>,
         trig: Option<(Tape, Vec<usize>)>,
+        /// The force solve's right-hand side.
+        force_rhs: Option<Tape>,
     },
 }
 
 impl PlanStage {
-    /// Stage `s` of `plan`, its tapes reading the trig cache as the generated kernels do.
-    fn new(arena: &mechgen::expr::Arena, plan: &Plan, s: usize) -> Self {
+    /// Stage `s` of `plan` (and of the force solve's plan `forces`), its tapes reading the trig
+    /// cache as the generated kernels do.
+    fn new(
+        arena: &mechgen::expr::Arena,
+        plan: &Plan,
+        forces: Option<&ForceStage>,
+        s: usize,
+    ) -> Self {
         let tape = |roots: &[mechgen::expr::Id], phase: Phase| {
             Tape::with_inputs(arena, roots, &plan.trig.reads(arena, roots, s, phase))
+        };
+        let force_tape = |kind_matches: Option<&Vec<mechgen::expr::Id>>| {
+            kind_matches.map(|roots| tape(roots, Phase::Final))
         };
         let fills: Vec<usize> = plan.trig.fills(s).collect();
         let trig = (!fills.is_empty()).then(|| {
@@ -123,6 +141,10 @@ impl PlanStage {
                         level(|a| a.acceleration, Phase::After),
                     ],
                     trig,
+                    multipliers: force_tape(match forces {
+                        Some(ForceStage::Explicit(values)) => Some(values),
+                        _ => None,
+                    }),
                 }
             }
             structure::Stage::Block(block) => {
@@ -150,19 +172,29 @@ impl PlanStage {
                         .as_deref()
                         .map(|v| tape(v, Phase::After)),
                     trig,
+                    force_rhs: force_tape(match forces {
+                        Some(ForceStage::Block(values)) => Some(values),
+                        _ => None,
+                    }),
                 }
             }
         }
     }
 
     fn tapes(&self) -> impl Iterator<Item = &Tape> {
-        let (levels, block, trig): (&[Option<Tape>], [Option<&Tape>; 3], _) = match self {
-            PlanStage::Explicit { levels, trig, .. } => (&levels[..], [None; 3], trig),
+        let (levels, block, trig): (&[Option<Tape>], [Option<&Tape>; 4], _) = match self {
+            PlanStage::Explicit {
+                levels,
+                trig,
+                multipliers,
+                ..
+            } => (&levels[..], [multipliers.as_ref(), None, None, None], trig),
             PlanStage::Block {
                 jacobian,
                 velocity_rhs,
                 acceleration_rhs,
                 trig,
+                force_rhs,
                 ..
             } => (
                 &[][..],
@@ -170,6 +202,7 @@ impl PlanStage {
                     Some(jacobian),
                     velocity_rhs.as_ref(),
                     acceleration_rhs.as_ref(),
+                    force_rhs.as_ref(),
                 ],
                 trig,
             ),
@@ -229,9 +262,19 @@ impl Interpreted {
             .map(|&b| Tape::new(arena, &[b]))
             .collect();
         let plan: &Plan = &scene.plan;
+        let force_stages = scene.forces.as_ref().map(|f| &f.stages);
         let stages: Vec<PlanStage> = (0..plan.stages.len())
-            .map(|s| PlanStage::new(arena, plan, s))
+            .map(|s| PlanStage::new(arena, plan, force_stages.and_then(|f| f.get(s)), s))
             .collect();
+        let forces = scene.forces.as_ref().map(|f| {
+            (
+                Tape::new(arena, &f.generalized),
+                Tape::new(arena, &f.reactions),
+            )
+        });
+        let force_storage = scene.forces.as_ref().map_or(0, |_| {
+            model.dim() + plan.blocks().map(structure::Block::slots).sum::<usize>()
+        });
         let cached_branches: Vec<Tape> = kin
             .branches
             .iter()
@@ -246,6 +289,7 @@ impl Interpreted {
             .iter()
             .chain(&nu)
             .chain(&gamma)
+            .chain(forces.iter().flat_map(|(f, r)| [f, r]))
             .chain([&lengths, &geometry_values])
             .chain(&branches)
             .chain(&cached_branches)
@@ -265,6 +309,7 @@ impl Interpreted {
             mechgen::model::Outputs::Positions => Outputs::Positions,
             mechgen::model::Outputs::Velocities => Outputs::Velocities,
             mechgen::model::Outputs::Accelerations => Outputs::Accelerations,
+            mechgen::model::Outputs::Forces => Outputs::Forces,
         };
         Interpreted {
             name: model.name.to_string(),
@@ -278,6 +323,8 @@ impl Interpreted {
             phi_and_jacobian,
             nu,
             gamma,
+            forces,
+            reaction_names: model.reaction_names(),
             outputs,
             pattern: kin.jacobian.iter().map(|e| (e.row, e.col)).collect(),
             coordinate_units: model.coordinate_units().into_iter().map(unit).collect(),
@@ -291,7 +338,12 @@ impl Interpreted {
             cached_branches,
             stages,
             reads: plan.reads.clone(),
-            largest: (plan.largest_block(), plan.largest_slots(), plan.trig.len()),
+            largest: (
+                plan.largest_block(),
+                plan.largest_slots(),
+                plan.trig.len(),
+                force_storage,
+            ),
             evaluations: Cell::new(0),
             scratch: RefCell::new(Scratch {
                 slots: vec![0.0; slots],
@@ -344,6 +396,7 @@ impl Interpreted {
             qd,
             qdd,
             trig,
+            lambda: &[],
             t,
             params: &self.params,
         }
@@ -533,12 +586,48 @@ impl Mechanism for Interpreted {
             None => out.as_mut_slice().fill(f64::NAN),
         }
     }
+
+    fn generalized_forces(
+        &self,
+        q: &Vector<Dyn>,
+        qd: &Vector<Dyn>,
+        qdd: &Vector<Dyn>,
+        t: f64,
+        out: &mut Vector<Dyn>,
+    ) {
+        match &self.forces {
+            Some((tape, _)) => {
+                let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), &[], t);
+                self.run(tape, inputs, |v| copy_into(v, out));
+            }
+            None => out.as_mut_slice().fill(f64::NAN),
+        }
+    }
+
+    fn reactions(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, lambda: &[f64], out: &mut Vector<Dyn>) {
+        match &self.forces {
+            Some((_, tape)) => {
+                let inputs = Inputs {
+                    lambda,
+                    ..self.inputs(q.as_slice(), qd.as_slice(), 0.0)
+                };
+                self.run(tape, inputs, |v| copy_into(v, out));
+            }
+            None => out.as_mut_slice().fill(f64::NAN),
+        }
+    }
+
+    fn reaction_name(&self, index: usize) -> Option<&str> {
+        self.forces.as_ref()?;
+        self.reaction_names.get(index).map(String::as_str)
+    }
 }
 
 /// One interpreter type serves every scene, so it is marked as computing every level; a scene
 /// that did not ask for an output writes NaN there, and the solver never asks for it.
 impl Velocities for Interpreted {}
 impl Accelerations for Interpreted {}
+impl Forces for Interpreted {}
 
 impl Structured for Interpreted {
     type Workspace = VecBuffers;
@@ -550,6 +639,7 @@ impl Structured for Interpreted {
             self.stages.len().max(1),
             self.coordinates.len(),
             self.largest.2,
+            self.largest.3,
         )
     }
 
@@ -724,6 +814,68 @@ impl Structured for Interpreted {
                 ..
             }) => {
                 let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t);
+                self.run(tape, inputs, |v| out.copy_from_slice(&v[..out.len()]));
+            }
+            _ => out.fill(f64::NAN),
+        }
+    }
+
+    fn assign_multipliers(
+        &self,
+        stage: usize,
+        q: &Vector<Dyn>,
+        trig: &[f64],
+        qd: &Vector<Dyn>,
+        qdd: &Vector<Dyn>,
+        lambda: &mut [f64],
+        t: f64,
+    ) {
+        let Some(PlanStage::Explicit {
+            equations,
+            multipliers,
+            ..
+        }) = self.stages.get(stage)
+        else {
+            return;
+        };
+        let inputs = Inputs {
+            lambda,
+            ..self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t)
+        };
+        // Every multiplier is computed before any is written, as generated code loads first.
+        let mut scratch = self.scratch.borrow_mut();
+        let Scratch { slots, values } = &mut *scratch;
+        match multipliers {
+            Some(tape) => tape.eval(inputs, slots, values),
+            None => values.fill(f64::NAN),
+        }
+        for (&e, &v) in equations.iter().zip(values.iter()) {
+            if let Some(l) = lambda.get_mut(e) {
+                *l = v;
+            }
+        }
+    }
+
+    fn force_rhs(
+        &self,
+        stage: usize,
+        q: &Vector<Dyn>,
+        trig: &[f64],
+        qd: &Vector<Dyn>,
+        qdd: &Vector<Dyn>,
+        lambda: &[f64],
+        t: f64,
+        out: &mut [f64],
+    ) {
+        match self.stages.get(stage) {
+            Some(PlanStage::Block {
+                force_rhs: Some(tape),
+                ..
+            }) => {
+                let inputs = Inputs {
+                    lambda,
+                    ..self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t)
+                };
                 self.run(tape, inputs, |v| out.copy_from_slice(&v[..out.len()]));
             }
             _ => out.fill(f64::NAN),

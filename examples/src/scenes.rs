@@ -1,5 +1,6 @@
 //! The example scenes, declared with `mechanism!`. Each has a `.mech` twin in `scenes/` for the
-//! CLI; a test holds the two to the same tokens.
+//! CLI; a test holds the two to the same tokens. `PistonCrankDynamics` is the seed with mass
+//! properties and gravity: the force solve's example.
 
 use mechgen_runtime::mechanism;
 
@@ -32,6 +33,39 @@ mechanism! {
         /// The piston stays on the liner's side of the crank pin: the rod, from crank pin to piston
         /// pin, points along the cylinder axis (bearing to liner).
         branch piston_outboard: dot(bearing -> liner, rod @ (41.3, 0) -> rod @ (0, 102.6)) > 0;
+    }
+}
+
+mechanism! {
+    /// Piston-crank of a boxer engine with its mass properties: the seed (mm, kg, rad, s), each
+    /// body's reference point at its centre of mass, under gravity, for the driving torque and the
+    /// loads on every pin and bearing (forces in kg·mm/s² = mN, torques in kg·mm²/s² = µN·m).
+    pub mechanism PistonCrankDynamics {
+        /// Crank speed (rad/s).
+        param omega = 314.0;
+
+        /// Cylinder liner (fixed).
+        ground liner at (156.8, 0, 0);
+        /// Piston, sliding in the liner.
+        body piston near (130, 0, 0) mass 0.5 inertia 300;
+        /// Connecting rod.
+        body rod near (29, 72, -2.35) mass 0.4 inertia 1500;
+        /// Crank shaft.
+        body crank near (0, 0, 0) mass 1.2 inertia 2000;
+        /// Crank bearing (fixed).
+        ground bearing at (0, 0, 0);
+
+        joint crank_pin: revolute(rod @ (41.3, 0), crank @ (0, 43));
+        joint piston_pin: revolute(piston @ (-28, 0), rod @ (0, 102.6));
+        joint main_bearing: revolute(crank, bearing);
+        joint slide: prismatic(liner, piston, along (1, 0));
+
+        driver crank_angle: angle(crank) = omega * t;
+
+        /// The piston stays on the liner's side of the crank pin.
+        branch piston_outboard: dot(bearing -> liner, rod @ (41.3, 0) -> rod @ (0, 102.6)) > 0;
+
+        gravity (0, -9810);
     }
 }
 

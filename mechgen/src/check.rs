@@ -2,7 +2,10 @@
 //! problem at the tokens that caused it, with a hint on how to fix it.
 //!
 //! All errors are collected and returned together (serde's `Ctxt` habit), so a user fixing a
-//! scene sees everything at once rather than one error per build.
+//! scene sees everything at once rather than one error per build. The dynamics part of a spec
+//! (mass properties, gravity, loads) is checked in `check/dynamics.rs`.
+
+mod dynamics;
 
 use std::collections::HashMap;
 
@@ -74,6 +77,7 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
                 };
                 [x, y, cx.angle(angle)]
             },
+            mass: cx.mass(b),
         })
         .collect();
 
@@ -112,6 +116,9 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
         .iter()
         .filter_map(|decl| cx.branch(decl))
         .collect();
+    let gravity = cx.gravity(spec);
+    let loads = spec.loads.iter().filter_map(|decl| cx.load(decl)).collect();
+    cx.check_forces(spec, outputs);
     // A rejected joint or driver would make the degree-of-freedom count misleading: count only a
     // scene whose parts all checked.
     let count = cx.errors.is_empty();
@@ -124,6 +131,8 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
         bodies,
         constraints,
         branches,
+        gravity,
+        loads,
         outputs,
     };
     if count {
@@ -160,7 +169,8 @@ impl Checker {
             .chain(spec.bodies.iter().map(|b| (&b.name, "body")))
             .chain(spec.joints.iter().map(|j| (&j.name, "joint")))
             .chain(spec.drivers.iter().map(|d| (&d.name, "driver")))
-            .chain(spec.branches.iter().map(|b| (&b.name, "branch")));
+            .chain(spec.branches.iter().map(|b| (&b.name, "branch")))
+            .chain(spec.loads.iter().map(|l| (&l.name, "load")));
         for (name, what) in names {
             let key = name.to_string();
             if key == "t" {
@@ -175,7 +185,7 @@ impl Checker {
                     name.span(),
                     format!(
                         "duplicate name `{key}`: a {first} of that name is declared above; \
-                         every parameter, body, joint, driver and branch needs its own name"
+                         every parameter, body, joint, driver, branch and load needs its own name"
                     ),
                 );
             } else {
@@ -197,11 +207,17 @@ impl Checker {
         }
     }
 
-    /// `outputs positions[, velocities[, accelerations]];`: a prefix of the three levels, in
-    /// order, since each needs the one before (velocities solve at the positions, …).
+    /// `outputs positions[, velocities[, accelerations[, forces]]];`: a prefix of the four
+    /// levels, in order, since each needs the one before (velocities solve at the positions,
+    /// …). Without the statement: everything the scene can compute (forces when it declares
+    /// masses or loads).
     fn outputs(&mut self, spec: &Spec) -> Outputs {
         let Some(names) = &spec.outputs else {
-            return Outputs::Accelerations;
+            return if dynamics::declared(spec) {
+                Outputs::Forces
+            } else {
+                Outputs::Accelerations
+            };
         };
         for (k, name) in names.iter().enumerate() {
             let expected = Outputs::NAMES.get(k);
@@ -210,19 +226,19 @@ impl Checker {
             }
             let message = if !Outputs::NAMES.contains(&name.to_string().as_str()) {
                 format!(
-                    "unknown output `{name}`; the outputs are `positions`, `velocities` and \
-                     `accelerations`"
+                    "unknown output `{name}`; the outputs are `positions`, `velocities`, \
+                     `accelerations` and `forces`"
                 )
             } else {
                 "list outputs in order, each with the ones it needs: `outputs positions;`, \
-                 `outputs positions, velocities;` or `outputs positions, velocities, \
-                 accelerations;`"
+                 `outputs positions, velocities;`, `outputs positions, velocities, \
+                 accelerations;` or `outputs positions, velocities, accelerations, forces;`"
                     .to_owned()
             };
             self.errors.push(name.span(), message);
             return Outputs::Accelerations;
         }
-        Outputs::ALL[names.len().clamp(1, 3) - 1]
+        Outputs::ALL[names.len().clamp(1, Outputs::ALL.len()) - 1]
     }
 
     /// Names every moving body that no joint joins and no driver moves: it floats freely, and

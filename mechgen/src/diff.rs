@@ -76,6 +76,24 @@ impl Differentiator {
         self.memo.insert((e, var), d);
         d
     }
+
+    /// The time derivative of `e` along the motion, `Σ ∂e/∂q_k q̇_k + Σ ∂e/∂q̇_k q̈_k + ∂e/∂t`
+    /// (q, q̇ and t independent symbols; `e` reads no q̈ or λ).
+    pub fn time_derivative(&mut self, arena: &mut Arena, e: Id) -> Id {
+        let mut total = arena.zero();
+        for var in arena.variables(e) {
+            let rate = match var {
+                Var::Q(k) => arena.var(Var::Qd(k)),
+                Var::Qd(k) => arena.var(Var::Qdd(k)),
+                Var::T => arena.one(),
+                Var::Qdd(_) | Var::Lambda(_) => continue,
+            };
+            let partial = self.diff(arena, e, var);
+            let term = arena.mul(partial, rate);
+            total = arena.add(total, term);
+        }
+        total
+    }
 }
 
 /// f'(a) for `e = f(a)`, written in terms of nodes that usually exist already.
@@ -119,6 +137,7 @@ mod tests {
                 Var::Q(k) => env.q[k as usize] += delta,
                 Var::Qd(k) => env.qd[k as usize] += delta,
                 Var::Qdd(k) => env.qdd[k as usize] += delta,
+                Var::Lambda(_) => unreachable!("no multipliers in these expressions"),
                 Var::T => env.t += delta,
             }
             eval(arena, e, &env)
@@ -163,6 +182,36 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn time_derivatives_follow_the_motion() {
+        // d/dt (x sin θ + t²) = ẋ sin θ + x cos θ θ̇ + 2t, and once more with ẍ and θ̈.
+        let mut a = Arena::new();
+        let (x, th, t) = (a.var(Var::Q(0)), a.var(Var::Q(1)), a.var(Var::T));
+        let s = a.sin(th);
+        let xs = a.mul(x, s);
+        let t2 = a.powi(t, 2);
+        let e = a.add(xs, t2);
+        let mut d = Differentiator::new();
+        let rate = d.time_derivative(&mut a, e);
+        let second = d.time_derivative(&mut a, rate);
+        let env = Env {
+            q: vec![1.5, 0.3],
+            qd: vec![-0.7, 2.0],
+            qdd: vec![0.4, -1.1],
+            t: 0.8,
+            params: vec![],
+        };
+        let [x, th] = [1.5_f64, 0.3];
+        let [xd, thd] = [-0.7_f64, 2.0];
+        let [xdd, thdd] = [0.4_f64, -1.1];
+        let exact_rate = xd * th.sin() + x * th.cos() * thd + 2.0 * 0.8;
+        let exact_second = xdd * th.sin() + 2.0 * xd * th.cos() * thd - x * th.sin() * thd * thd
+            + x * th.cos() * thdd
+            + 2.0;
+        assert!((eval(&a, rate, &env) - exact_rate).abs() < 1e-14);
+        assert!((eval(&a, second, &env) - exact_second).abs() < 1e-14);
     }
 
     #[test]

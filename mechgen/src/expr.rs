@@ -1,4 +1,5 @@
-//! The expression IR: a hash-consed DAG of scalar expressions over q, q̇, q̈, t and parameters.
+//! The expression IR: a hash-consed DAG of scalar expressions over q, q̇, q̈, λ, t and
+//! parameters.
 //!
 //! Every node lives once in an [`Arena`]; structurally equal expressions get the same [`Id`], so
 //! common sub-expressions (each sin θ, cos θ, products of them) are shared by construction and the
@@ -29,6 +30,9 @@ pub enum Var {
     /// Coordinate acceleration q̈_k (read by the structured solve's acceleration right-hand
     /// sides, where earlier stages' accelerations are known).
     Qdd(u32),
+    /// Lagrange multiplier λ_i of equation i (read by the force solve, where later stages'
+    /// multipliers are known).
+    Lambda(u32),
     /// Time.
     T,
 }

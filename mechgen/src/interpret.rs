@@ -77,6 +77,8 @@ pub struct Inputs<'a, S = f64> {
     /// The solve's trig cache (sines and cosines of solved angles), for tapes built with
     /// [`Tape::with_inputs`]; empty otherwise.
     pub trig: &'a [f64],
+    /// Lagrange multipliers by equation (the force solve's); empty otherwise.
+    pub lambda: &'a [f64],
     /// Time.
     pub t: f64,
     /// Parameter values by declaration index.
@@ -91,6 +93,7 @@ impl Env {
             qd: &self.qd,
             qdd: &self.qdd,
             trig: &[],
+            lambda: &[],
             t: self.t,
             params: &self.params,
         }
@@ -114,6 +117,7 @@ enum Op {
     Q(usize),
     Qd(usize),
     Qdd(usize),
+    Lambda(usize),
     /// A node read from the trig cache instead of computed.
     Cached(usize),
     T,
@@ -156,6 +160,7 @@ impl Tape {
                 Node::Var(Var::Q(k)) => Op::Q(k as usize),
                 Node::Var(Var::Qd(k)) => Op::Qd(k as usize),
                 Node::Var(Var::Qdd(k)) => Op::Qdd(k as usize),
+                Node::Var(Var::Lambda(i)) => Op::Lambda(i as usize),
                 Node::Var(Var::T) => Op::T,
                 Node::Neg(a) => Op::Neg(s(a)),
                 Node::Add(a, b) => Op::Add(s(a), s(b)),
@@ -225,6 +230,7 @@ impl Tape {
                 Op::Q(k) => get(inputs.q, k),
                 Op::Qd(k) => get(inputs.qd, k),
                 Op::Qdd(k) => get(inputs.qdd, k),
+                Op::Lambda(i) => S::from_f64(inputs.lambda.get(i).copied().unwrap_or(f64::NAN)),
                 Op::Cached(k) => S::from_f64(inputs.trig.get(k).copied().unwrap_or(f64::NAN)),
                 Op::T => S::from_f64(inputs.t),
                 Op::Neg(a) => -scratch[a],
@@ -379,6 +385,7 @@ mod tests {
             qd: &[],
             qdd: &[],
             trig: &[],
+            lambda: &[],
             t: 0.0,
             params: &[p0],
         };

@@ -187,7 +187,8 @@ fn branch_values(model: &mut Model) -> Vec<Id> {
         .collect()
 }
 
-fn ground_poses(model: &Model) -> Vec<Option<[Id; 3]>> {
+/// The pose of each ground body (`None` for moving bodies): how joints see the frame.
+pub(crate) fn ground_poses(model: &Model) -> Vec<Option<[Id; 3]>> {
     model
         .bodies
         .iter()
@@ -235,11 +236,24 @@ fn col_u32(col: usize) -> u32 {
 /// pose: the solutions are the same, and ground bodies cost no trigonometry and no Jacobian
 /// entries outside their own rows.
 pub(crate) fn constraint_equations(model: &mut Model) -> Vec<Id> {
-    let constraints: Vec<ConstraintKind> = model.constraints.iter().map(|c| c.kind).collect();
     let poses = ground_poses(model);
+    equations_with(model, &poses)
+}
+
+/// Φ with every body through its coordinates, ground bodies included (the textbook
+/// formulation, in which the joints touch the frame's coordinates): the force solve
+/// differentiates it for the loads the joints put on ground bodies.
+pub(crate) fn textbook_equations(model: &mut Model) -> Vec<Id> {
+    let poses = vec![None; model.bodies.len()];
+    equations_with(model, &poses)
+}
+
+/// Φ in equation order, each body seen through `poses` (a constant pose) or its coordinates.
+fn equations_with(model: &mut Model, poses: &[Option<[Id; 3]>]) -> Vec<Id> {
+    let constraints: Vec<ConstraintKind> = model.constraints.iter().map(|c| c.kind).collect();
     let mut f = Frames {
         arena: &mut model.arena,
-        poses: &poses,
+        poses,
     };
     let mut phi = Vec::new();
     for kind in constraints {
@@ -284,15 +298,15 @@ pub(crate) fn constraint_equations(model: &mut Model) -> Vec<Id> {
 
 /// Body frames as joints see them: a moving body through its coordinates, a ground body
 /// through its constant pose.
-struct Frames<'a> {
-    arena: &'a mut Arena,
+pub(crate) struct Frames<'a> {
+    pub(crate) arena: &'a mut Arena,
     /// The pose of each ground body; `None` for moving bodies.
-    poses: &'a [Option<[Id; 3]>],
+    pub(crate) poses: &'a [Option<[Id; 3]>],
 }
 
 impl Frames<'_> {
     /// Coordinate `k` (0 x, 1 y, 2 θ) of `body`: q for a moving body, the pose for a ground one.
-    fn pose(&mut self, body: usize, k: usize) -> Id {
+    pub(crate) fn pose(&mut self, body: usize, k: usize) -> Id {
         match self.poses.get(body).copied().flatten() {
             Some(pose) => pose[k],
             None => self.arena.var(Var::Q(col_u32(3 * body + k))),
@@ -300,7 +314,7 @@ impl Frames<'_> {
     }
 
     /// A(θ_body) v
-    fn rotate(&mut self, body: usize, v: [Id; 2]) -> [Id; 2] {
+    pub(crate) fn rotate(&mut self, body: usize, v: [Id; 2]) -> [Id; 2] {
         let theta = self.pose(body, 2);
         let a = &mut *self.arena;
         let (c, s) = (a.cos(theta), a.sin(theta));
@@ -310,14 +324,14 @@ impl Frames<'_> {
     }
 
     /// r_body + A(θ_body) s
-    fn world_point(&mut self, p: Point) -> [Id; 2] {
+    pub(crate) fn world_point(&mut self, p: Point) -> [Id; 2] {
         let offset = self.rotate(p.body, p.local);
         let (x, y) = (self.pose(p.body, 0), self.pose(p.body, 1));
         [self.arena.add(x, offset[0]), self.arena.add(y, offset[1])]
     }
 
     /// World vector from `from`'s point to `to`'s point.
-    fn separation(&mut self, from: Point, to: Point) -> [Id; 2] {
+    pub(crate) fn separation(&mut self, from: Point, to: Point) -> [Id; 2] {
         let (rf, rt) = (self.world_point(from), self.world_point(to));
         [self.arena.sub(rt[0], rf[0]), self.arena.sub(rt[1], rf[1])]
     }
@@ -334,7 +348,8 @@ impl Frames<'_> {
         }
     }
 
-    fn dot(&mut self, u: [Id; 2], v: [Id; 2]) -> Id {
+    /// u · v
+    pub(crate) fn dot(&mut self, u: [Id; 2], v: [Id; 2]) -> Id {
         let (x, y) = (self.arena.mul(u[0], v[0]), self.arena.mul(u[1], v[1]));
         self.arena.add(x, y)
     }

@@ -4,6 +4,7 @@
 //!
 //! ```text
 //! tokens / .mech ─parse─▶ Spec ─check─▶ Model ─kinematics─▶ Φ, Φ_q, ν, γ (IR) ─structure─▶ Plan
+//!        (scenes that compute forces) ─dynamics─▶ F ─reactions─▶ reverse stages, reactions
 //!                                                  ─emit─▶ Rust tokens
 //!                                                  └─interpret─▶ numbers
 //! ```
@@ -16,6 +17,7 @@
 pub mod builder;
 pub mod check;
 pub mod diff;
+pub mod dynamics;
 pub mod emit;
 pub mod error;
 pub mod expr;
@@ -27,6 +29,7 @@ pub mod kinematics;
 pub mod limits;
 pub mod model;
 pub mod parse;
+pub mod reactions;
 pub mod resolution;
 pub mod spec;
 pub mod stats;
@@ -49,6 +52,9 @@ pub struct Scene {
     pub kinematics: Kinematics,
     /// The stages of the solve: explicit assignments and Newton blocks with their static LU.
     pub plan: structure::Plan,
+    /// The force solve, for a scene that computes forces: the generalised forces, the plan's
+    /// stages in reverse, the reported reactions.
+    pub forces: Option<reactions::Forces>,
 }
 
 /// Parses, checks and differentiates a spec given as tokens.
@@ -75,14 +81,20 @@ fn scene(spec: &spec::Spec) -> Result<Scene, Errors> {
 }
 
 impl Scene {
-    /// The stages after `check`: kinematics, then the solve structure.
+    /// The stages after `check`: kinematics, the solve structure, and for a scene that
+    /// computes forces its dynamics and the force solve's structure.
     fn derive(mut model: Model) -> Self {
         let kinematics = kinematics::derive(&mut model);
         let plan = structure::plan(&mut model, &kinematics);
+        let forces = (model.outputs >= model::Outputs::Forces).then(|| {
+            let generalized = dynamics::derive(&mut model);
+            reactions::plan(&mut model, &kinematics, &plan, generalized)
+        });
         Scene {
             model,
             kinematics,
             plan,
+            forces,
         }
     }
 }

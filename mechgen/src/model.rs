@@ -27,6 +27,10 @@ pub struct Model {
     pub constraints: Vec<Constraint>,
     /// Branch invariants in declaration order (their values are derived by `kinematics`).
     pub branches: Vec<Branch>,
+    /// The acceleration of gravity in world axes (zero unless declared).
+    pub gravity: [Id; 2],
+    /// Applied loads in declaration order.
+    pub loads: Vec<Load>,
     /// What the scene asked to compute.
     pub outputs: Outputs,
 }
@@ -41,17 +45,30 @@ pub enum Outputs {
     Velocities,
     /// Positions, velocities and accelerations.
     Accelerations,
+    /// All three, and the reactions and driver efforts that produce the motion.
+    Forces,
 }
 
 impl Outputs {
     /// Every level, in order; `ALL[k]` is named `NAMES[k]` in specs.
-    pub const ALL: [Outputs; 3] = [
+    pub const ALL: [Outputs; 4] = [
         Outputs::Positions,
         Outputs::Velocities,
         Outputs::Accelerations,
+        Outputs::Forces,
     ];
     /// The names used in the `outputs` statement.
-    pub const NAMES: [&'static str; 3] = ["positions", "velocities", "accelerations"];
+    pub const NAMES: [&'static str; 4] = ["positions", "velocities", "accelerations", "forces"];
+
+    /// The variant's name (`Positions`, …), as in `mechgen_runtime::Outputs`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Outputs::Positions => "Positions",
+            Outputs::Velocities => "Velocities",
+            Outputs::Accelerations => "Accelerations",
+            Outputs::Forces => "Forces",
+        }
+    }
 }
 
 /// A run-time parameter.
@@ -76,6 +93,62 @@ pub struct Body {
     pub ground: bool,
     /// Ground pose or initial guess, as expressions in parameters.
     pub pose: [Id; 3],
+    /// Mass properties of a moving body, if declared (massless otherwise).
+    pub mass: Option<MassProperties>,
+}
+
+/// A moving body's mass properties, as expressions in parameters.
+#[derive(Clone, Copy)]
+pub struct MassProperties {
+    /// The mass.
+    pub mass: Id,
+    /// The moment of inertia about the centre of mass.
+    pub inertia: Id,
+    /// The centre of mass in the body's frame.
+    pub centre: [Id; 2],
+}
+
+/// A named applied load.
+#[derive(Clone)]
+pub struct Load {
+    /// Name as declared.
+    pub name: String,
+    /// What it applies.
+    pub kind: LoadKind,
+}
+
+/// The loads of the spec language; each is only its force law (see `dynamics`).
+#[derive(Clone, Copy)]
+pub enum LoadKind {
+    /// A force at a point, in world or body axes, with components in t and parameters.
+    Force {
+        /// Where it acts (on a moving body).
+        point: Point,
+        /// Its components.
+        value: [Id; 2],
+        /// In the body's axes (turning with it) rather than the world's.
+        local: bool,
+    },
+    /// A torque on a moving body, in t and parameters.
+    Torque {
+        /// The body.
+        body: usize,
+        /// Its value.
+        value: Id,
+    },
+    /// A linear spring-damper between two points: tension `k (ℓ − L) + c ℓ̇`.
+    Spring {
+        /// First point.
+        a: Point,
+        /// Second point.
+        b: Point,
+        /// Stiffness k.
+        stiffness: Id,
+        /// Free length L.
+        length: Id,
+        /// Damping c.
+        damping: Id,
+    },
 }
 
 /// A point fixed to a body: body-frame coordinates as expressions in parameters.
@@ -231,6 +304,20 @@ impl ConstraintKind {
         }
     }
 
+    /// Suffixes naming the reaction each equation reports when the scene computes forces, in
+    /// equation order: a ground body's load (`fx`, `fy`, `torque`), a revolute joint's force
+    /// (`fx`, `fy`), a prismatic joint's `normal` and `torque`, a distance joint's `tension`,
+    /// a driver's `effort`.
+    pub fn reaction_suffixes(&self) -> &'static [&'static str] {
+        match self {
+            ConstraintKind::Ground { .. } => &["fx", "fy", "torque"],
+            ConstraintKind::Revolute { .. } => &["fx", "fy"],
+            ConstraintKind::Prismatic { .. } => &["normal", "torque"],
+            ConstraintKind::Distance { .. } => &["tension"],
+            ConstraintKind::Driver { .. } => &["effort"],
+        }
+    }
+
     /// The body-fixed points this constraint places (none for ground equations and angle
     /// drivers).
     pub fn points(&self) -> Vec<Point> {
@@ -280,6 +367,20 @@ impl Model {
                         format!("{}.{s}", c.name)
                     }
                 })
+            })
+            .collect()
+    }
+
+    /// Reaction names in Φ order (`liner.fx`, …, `crank_pin.fx`, …, `crank_angle.effort`): what
+    /// each equation reports when the scene computes forces.
+    pub fn reaction_names(&self) -> Vec<String> {
+        self.constraints
+            .iter()
+            .flat_map(|c| {
+                c.kind
+                    .reaction_suffixes()
+                    .iter()
+                    .map(move |s| format!("{}.{s}", c.name))
             })
             .collect()
     }
@@ -359,6 +460,11 @@ impl Model {
             vector(b.u),
             vector(b.v)
         )
+    }
+
+    /// Whether anything in the scene produces a force: a body's mass properties or a load.
+    pub fn has_dynamics(&self) -> bool {
+        self.bodies.iter().any(|b| b.mass.is_some()) || !self.loads.is_empty()
     }
 
     /// Number of drivers (the mechanism's degrees of freedom, checked).

@@ -10,8 +10,8 @@ use syn::parse::{Parse, ParseStream};
 use syn::{Attribute, Ident, LitFloat, LitInt, Token, Visibility, braced, parenthesized};
 
 use crate::spec::{
-    BinOp, BodyDecl, BranchDecl, DriverDecl, DriverKind, Expr, ExprKind, JointDecl, JointKind,
-    ParamDecl, PointRef, Product, Sign, Spec,
+    BinOp, BodyDecl, BranchDecl, DriverDecl, DriverKind, Expr, ExprKind, GravityDecl, JointDecl,
+    JointKind, LoadDecl, LoadKind, MassDecl, ParamDecl, PointRef, Product, Sign, Spec,
 };
 
 mod kw {
@@ -26,6 +26,15 @@ mod kw {
     syn::custom_keyword!(along);
     syn::custom_keyword!(outputs);
     syn::custom_keyword!(branch);
+    syn::custom_keyword!(mass);
+    syn::custom_keyword!(inertia);
+    syn::custom_keyword!(centre);
+    syn::custom_keyword!(center);
+    syn::custom_keyword!(gravity);
+    syn::custom_keyword!(load);
+    syn::custom_keyword!(stiffness);
+    syn::custom_keyword!(length);
+    syn::custom_keyword!(damping);
 }
 
 /// Parses a `mechanism` declaration from tokens (the macro's input).
@@ -68,6 +77,8 @@ impl Parse for Spec {
             joints: Vec::new(),
             drivers: Vec::new(),
             branches: Vec::new(),
+            gravity: None,
+            loads: Vec::new(),
             outputs: None,
         };
         while !content.is_empty() {
@@ -129,12 +140,14 @@ fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> {
             })?;
         }
         let (pose, _) = tuple::<3>(input, "(x, y, angle)")?;
+        let mass = mass_clause(input)?;
         spec.bodies.push(BodyDecl {
             docs,
             keyword,
             name,
             ground,
             pose,
+            mass,
         });
     } else if look.peek(kw::joint) {
         input.parse::<kw::joint>()?;
@@ -177,6 +190,30 @@ fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> {
         let name = input.parse()?;
         input.parse::<Token![:]>()?;
         spec.branches.push(branch(input, docs, name)?);
+    } else if look.peek(kw::gravity) {
+        let keyword = input.parse::<kw::gravity>()?;
+        if !docs.is_empty() || spec.gravity.is_some() {
+            return Err(syn::Error::new(
+                keyword.span,
+                "a scene has at most one `gravity (gx, gy);` statement, without doc comments",
+            ));
+        }
+        let (value, _) = tuple::<2>(input, "(gx, gy): gravity's world components")?;
+        spec.gravity = Some(GravityDecl {
+            span: keyword.span,
+            value,
+        });
+    } else if look.peek(kw::load) {
+        input.parse::<kw::load>()?;
+        let name = input.parse()?;
+        input.parse::<Token![:]>()?;
+        let (kind_span, kind) = load_kind(input)?;
+        spec.loads.push(LoadDecl {
+            docs,
+            name,
+            kind_span,
+            kind,
+        });
     } else {
         return Err(look.error());
     }
@@ -357,6 +394,134 @@ fn driver_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, DriverKind
     Ok((kind.span(), driver))
 }
 
+/// `mass m`, `inertia J` and `centre (x, y)` after a body's pose, in any order, each at most
+/// once; `None` when there is none.
+fn mass_clause(input: ParseStream) -> syn::Result<Option<MassDecl>> {
+    let start = input.span();
+    let (mut mass, mut inertia, mut centre) = (None, None, None);
+    loop {
+        let span = input.span();
+        let (taken, what) = if input.peek(kw::mass) {
+            input.parse::<kw::mass>()?;
+            (Option::replace(&mut mass, input.parse()?).is_some(), "mass")
+        } else if input.peek(kw::inertia) {
+            input.parse::<kw::inertia>()?;
+            (
+                Option::replace(&mut inertia, input.parse()?).is_some(),
+                "inertia",
+            )
+        } else if input.peek(kw::centre) || input.peek(kw::center) {
+            let _: Ident = input.parse()?;
+            let (xy, _) = tuple::<2>(input, "(x, y): the centre of mass in the body's frame")?;
+            (centre.replace((xy, span)).is_some(), "centre")
+        } else {
+            break;
+        };
+        if taken {
+            return Err(syn::Error::new(
+                span,
+                format!("`{what}` is given twice for this body; keep one"),
+            ));
+        }
+    }
+    let declared = mass.is_some() || inertia.is_some() || centre.is_some();
+    Ok(declared.then_some(MassDecl {
+        span: start,
+        mass,
+        inertia,
+        centre,
+    }))
+}
+
+/// `force(p) = (fx, fy)`, `local_force(p) = (fx, fy)`, `torque(body) = τ` or
+/// `spring(p, q, stiffness k, length L, damping c)` (after `load NAME:`).
+fn load_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, LoadKind)> {
+    let kind: Ident = input.parse()?;
+    let args;
+    parenthesized!(args in input);
+    let surplus = |args: ParseStream, advice: &str| -> syn::Result<()> {
+        if args.is_empty() {
+            Ok(())
+        } else {
+            Err(args.error(format!("unexpected argument: {advice}")))
+        }
+    };
+    let load = match kind.to_string().as_str() {
+        "force" | "local_force" => {
+            let point = args.parse()?;
+            surplus(
+                &args,
+                "a force acts at one point: `force(body @ (x, y)) = (fx, fy)`",
+            )?;
+            input.parse::<Token![=]>()?;
+            let (value, _) = tuple::<2>(input, "(fx, fy): the force's components")?;
+            LoadKind::Force {
+                point,
+                value,
+                local: kind == "local_force",
+            }
+        }
+        "torque" => {
+            let body = args.parse()?;
+            surplus(&args, "a torque turns one body: `torque(body) = value`")?;
+            input.parse::<Token![=]>()?;
+            LoadKind::Torque {
+                body,
+                value: input.parse()?,
+            }
+        }
+        "spring" => {
+            let a = args.parse()?;
+            args.parse::<Token![,]>()?;
+            let b = args.parse()?;
+            let (mut stiffness, mut length, mut damping) = (None, None, None);
+            while !args.is_empty() {
+                args.parse::<Token![,]>()?;
+                let span = args.span();
+                let slot = if args.peek(kw::stiffness) {
+                    args.parse::<kw::stiffness>()?;
+                    &mut stiffness
+                } else if args.peek(kw::length) {
+                    args.parse::<kw::length>()?;
+                    &mut length
+                } else if args.peek(kw::damping) {
+                    args.parse::<kw::damping>()?;
+                    &mut damping
+                } else {
+                    return Err(args.error(
+                        "expected `stiffness k`, `length L` or `damping c`, as in \
+                         `spring(a @ (x, y), b, stiffness 20, length 35, damping 0.1)`",
+                    ));
+                };
+                if slot.replace(args.parse()?).is_some() {
+                    return Err(syn::Error::new(
+                        span,
+                        "this spring argument is given twice; keep one",
+                    ));
+                }
+            }
+            LoadKind::Spring {
+                a,
+                b,
+                stiffness,
+                length,
+                damping,
+            }
+        }
+        other => {
+            return Err(syn::Error::new(
+                kind.span(),
+                format!(
+                    "unknown load kind `{other}`; expected `force(body @ (x, y)) = (fx, fy)`, \
+                     `local_force(body @ (x, y)) = (fx, fy)`, `torque(body) = value` or \
+                     `spring(a @ (x, y), b, stiffness k, length L, damping c)`"
+                ),
+            ));
+        }
+    };
+    Ok((kind.span(), load))
+}
+
 impl Parse for PointRef {
     fn parse(input: ParseStream) -> syn::Result<Self> {
         let body = input.parse()?;
@@ -375,6 +540,11 @@ fn tuple<const N: usize>(
     input: ParseStream,
     what: &str,
 ) -> syn::Result<([Expr; N], proc_macro2::Span)> {
+    if !input.peek(syn::token::Paren) {
+        return Err(input.error(format!(
+            "expected {N} comma-separated values in parentheses: {what}"
+        )));
+    }
     let content;
     let paren = parenthesized!(content in input);
     let mut items = Vec::with_capacity(N);
@@ -614,6 +784,50 @@ mod tests {
         assert!(err("mechanism M { branch b: cross(a -> b, c -> d); }").contains("`> 0` or `< 0`"));
         assert!(err("mechanism M { branch b: wedge(a -> b, c -> d) > 0; }").contains("`wedge`"));
         assert!(err("mechanism M { branch b: dot(a, b, c -> d) > 0; }").contains("`->`"));
+        assert!(err("mechanism M { body b near (0, 0, 0) mass 1 mass 2; }").contains("twice"));
+        assert!(err("mechanism M { gravity (0, 1); gravity (0, 2); }").contains("at most one"));
+        assert!(err("mechanism M { load l: push(b) = (1, 0); }").contains("unknown load kind"));
+        assert!(err("mechanism M { load l: spring(a, b, stiff 1); }").contains("`stiffness k`"));
+        assert!(err("mechanism M { load l: torque(a, b) = 1; }").contains("turns one body"));
+        assert!(err("mechanism M { load l: force(a) = 1; }").contains("expected 2"));
+        assert!(err("mechanism M { body b near 1; }").contains("(x, y, angle)"));
+    }
+
+    #[test]
+    fn parses_mass_properties_gravity_and_loads() {
+        let spec = parse_str(
+            "mechanism M {
+                body rod near (0, 0, 0) centre (1, 2) mass m inertia 0.5;
+                body arm near (0, 0, 0);
+                gravity (0, -9.81);
+                /// The gas force.
+                load gas: force(rod @ (1, 0)) = (-p * t, 0);
+                load thrust: local_force(arm) = (0, 1);
+                load brake: torque(arm) = -t;
+                load coil: spring(rod, arm @ (0, 1), damping 0.1, stiffness k, length 2);
+            }",
+        )
+        .unwrap_or_else(|e| panic!("parses: {e}"));
+        let mass = spec.bodies[0].mass.as_ref().expect("a mass clause");
+        assert!(mass.mass.is_some() && mass.inertia.is_some() && mass.centre.is_some());
+        assert!(spec.bodies[1].mass.is_none());
+        assert!(spec.gravity.is_some());
+        assert_eq!(spec.loads.len(), 4);
+        assert_eq!(spec.loads[0].docs.len(), 1);
+        assert!(matches!(
+            spec.loads[1].kind,
+            LoadKind::Force { local: true, .. }
+        ));
+        let LoadKind::Spring {
+            stiffness,
+            length,
+            damping,
+            ..
+        } = &spec.loads[3].kind
+        else {
+            panic!("a spring");
+        };
+        assert!(stiffness.is_some() && length.is_some() && damping.is_some());
     }
 
     #[test]

@@ -24,6 +24,10 @@ pub struct Spec {
     pub drivers: Vec<DriverDecl>,
     /// Branch invariants in declaration order.
     pub branches: Vec<BranchDecl>,
+    /// The `gravity (gx, gy);` statement, if any.
+    pub gravity: Option<GravityDecl>,
+    /// Applied loads (forces, torques, springs) in declaration order.
+    pub loads: Vec<LoadDecl>,
     /// The `outputs …;` statement, if any: the listed names with their spans.
     pub outputs: Option<Vec<proc_macro2::Ident>>,
 }
@@ -52,6 +56,83 @@ pub struct BodyDecl {
     pub ground: bool,
     /// Pose of a ground body, or the initial guess of a moving one.
     pub pose: [Expr; 3],
+    /// Mass properties (`mass m inertia J centre (x, y)`), if declared.
+    pub mass: Option<MassDecl>,
+}
+
+/// `mass 0.4 inertia 1500 centre (20, 0)` after a body's pose: its mass, its moment of inertia
+/// about the centre of mass, and the centre of mass in the body's frame (each optional; the
+/// centre defaults to the reference point).
+#[derive(Clone)]
+pub struct MassDecl {
+    /// Span of the clause's first keyword.
+    pub span: Span,
+    /// `mass m`.
+    pub mass: Option<Expr>,
+    /// `inertia J`: the moment of inertia about the centre of mass.
+    pub inertia: Option<Expr>,
+    /// `centre (x, y)` (or `center`): body-frame coordinates of the centre of mass, with the
+    /// span of the keyword.
+    pub centre: Option<([Expr; 2], Span)>,
+}
+
+/// `gravity (gx, gy);`: the acceleration of gravity in world axes.
+#[derive(Clone)]
+pub struct GravityDecl {
+    /// Span of the `gravity` keyword.
+    pub span: Span,
+    /// World components.
+    pub value: [Expr; 2],
+}
+
+/// `load NAME: KIND(…) [= value];`
+#[derive(Clone)]
+pub struct LoadDecl {
+    /// Doc comments.
+    pub docs: Vec<Attribute>,
+    /// Name of the load.
+    pub name: Ident,
+    /// Span of the load kind, for diagnostics.
+    pub kind_span: Span,
+    /// The load.
+    pub kind: LoadKind,
+}
+
+/// The applied loads of the spec language.
+#[derive(Clone)]
+pub enum LoadKind {
+    /// `force(point) = (fx, fy)` in world axes, or `local_force(point) = (fx, fy)` in the
+    /// body's axes (turning with it).
+    Force {
+        /// Where it acts.
+        point: PointRef,
+        /// Its components, in t and parameters.
+        value: [Expr; 2],
+        /// Body axes (`local_force`) rather than world axes.
+        local: bool,
+    },
+    /// `torque(body) = τ`.
+    Torque {
+        /// The body it turns.
+        body: Ident,
+        /// Its value, in t and parameters.
+        value: Expr,
+    },
+    /// `spring(p, q, stiffness k, length L, damping c)`: a linear spring-damper between two
+    /// points; each keyword argument is optional (stiffness and damping default to zero, but
+    /// one of them must be given; `length` goes with `stiffness`).
+    Spring {
+        /// First point.
+        a: PointRef,
+        /// Second point.
+        b: PointRef,
+        /// `stiffness k`.
+        stiffness: Option<Expr>,
+        /// `length L`: the free length.
+        length: Option<Expr>,
+        /// `damping c`.
+        damping: Option<Expr>,
+    },
 }
 
 /// A body-fixed point: `rod @ (41.3, 0)`, or `rod` alone for its reference point.

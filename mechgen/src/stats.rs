@@ -107,7 +107,8 @@ impl fmt::Display for OpCounts {
 /// Operation counts of one generated function.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FunctionCounts {
-    /// The generated function's name (`phi`, `jacobian`, `phi_and_jacobian`, `nu`, `gamma`).
+    /// The generated function's name (`phi`, `jacobian`, `phi_and_jacobian`, `nu`, `gamma`, and
+    /// for a scene that computes forces `generalized_forces`, `reactions`).
     pub function: &'static str,
     /// Non-zero outputs it writes (zeros come from one `fill(0.0)`).
     pub outputs: usize,
@@ -121,10 +122,12 @@ pub fn function_counts(scene: &Scene) -> Vec<FunctionCounts> {
     let arena = &scene.model.arena;
     // A naive scene (unsimplified arena) is emitted without sharing: count its trees.
     let naive = !arena.simplifies();
+    let forces = scene.forces.iter().flat_map(|f| f.function_outputs(arena));
     scene
         .kinematics
         .function_outputs(arena)
         .into_iter()
+        .chain(forces)
         .map(|(function, roots)| FunctionCounts {
             function,
             outputs: roots.len(),
@@ -139,14 +142,20 @@ pub fn function_counts(scene: &Scene) -> Vec<FunctionCounts> {
 
 /// [`function_counts`] as a text table (CLI `check --stats`, snapshots).
 pub fn table(scene: &Scene) -> String {
+    let functions = function_counts(scene);
+    // Wide enough for the longest name, and never narrower than the kinematic functions need.
+    let width = functions
+        .iter()
+        .map(|f| f.function.len() + 1)
+        .fold(17, usize::max);
     let mut out = format!(
-        "{:<17}{:>8}{:>6}{:>6}{:>8}{:>6}{:>6}{:>6}{:>6}\n",
+        "{:<width$}{:>8}{:>6}{:>6}{:>8}{:>6}{:>6}{:>6}{:>6}\n",
         "function", "outputs", "trig", "sqrt", "exp/ln", "mul", "add", "div", "neg"
     );
-    for f in function_counts(scene) {
+    for f in functions {
         let c = f.counts;
         out += &format!(
-            "{:<17}{:>8}{:>6}{:>6}{:>8}{:>6}{:>6}{:>6}{:>6}\n",
+            "{:<width$}{:>8}{:>6}{:>6}{:>8}{:>6}{:>6}{:>6}{:>6}\n",
             f.function, f.outputs, c.trig, c.sqrt, c.exp_ln, c.mul, c.add, c.div, c.neg
         );
     }
@@ -205,6 +214,13 @@ pub fn structure(scene: &Scene) -> String {
         plan.trig.angles.len(),
         if plan.trig.angles.len() == 1 { "" } else { "s" },
     );
+    if scene.forces.is_some() {
+        out += &format!(
+            "force solve, stages in reverse: {explicit} multipliers in closed form, {in_blocks} by \
+             transposed solves with the blocks' archived factors ({} values)\n",
+            blocks.iter().map(|b| b.slots()).sum::<usize>()
+        );
+    }
     out += &format!(
         "{:>6}  {:<9}{:>5}{:>9}{:>6}{:>9}  solves (coordinate ← equation)\n",
         "stage", "kind", "size", "entries", "fill", "updates"

@@ -65,13 +65,16 @@ pub struct TrigCache {
 }
 
 /// When a kernel of a stage runs: before the stage's positions are known (explicit positions,
-/// a block's Newton iteration) or after (its rates, its trig fill).
+/// a block's Newton iteration), after (its rates, its trig fill), or after the whole forward
+/// sweep (the force solve, in reverse).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Phase {
     /// Computing the stage's positions.
     Positions,
     /// After the stage's positions are known.
     After,
+    /// After every stage's positions are known: the whole cache is filled.
+    Final,
 }
 
 impl TrigCache {
@@ -102,6 +105,7 @@ impl TrigCache {
         let ready = |m: usize| match phase {
             Phase::Positions => self.filled_by[m] < stage,
             Phase::After => self.filled_by[m] <= stage,
+            Phase::Final => true,
         };
         crate::interpret::topological_order(arena, roots)
             .into_iter()
@@ -310,6 +314,7 @@ fn trig_cache(arena: &mut Arena, stages: &[Stage], n: usize) -> TrigCache {
                     let ready = match phase {
                         Phase::Positions => stage_of[k] < s,
                         Phase::After => stage_of[k] <= s,
+                        Phase::Final => true,
                     };
                     wanted[k] |= ready;
                 }
@@ -732,6 +737,7 @@ impl Planner<'_> {
             qd: &[],
             qdd: &[],
             trig: &[],
+            lambda: &[],
             t: 0.0,
             params: &self.params,
         };

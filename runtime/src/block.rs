@@ -245,6 +245,30 @@ where
         scale(x, scales.cols);
     }
 
+    /// `x ← J⁻ᵀ x` (`x` in local column order on entry, row order on return): the force
+    /// solve's `Jᵀ λ = r`. With `J = D_r⁻¹ S D_c⁻¹`, `λ = D_r S⁻ᵀ D_c r`.
+    pub fn solve_transpose(
+        &self,
+        factors: Factors,
+        storage: &FactorStorage<'_>,
+        scales: &Scales<'_>,
+        x: &mut [f64],
+    ) {
+        let x = &mut x[..self.n()];
+        scale(x, scales.cols);
+        self.solve_transpose_scaled(factors, storage, x);
+        scale(x, scales.rows);
+    }
+
+    /// [`BlockSolve::solve_transpose`] with static factors kept elsewhere (`values`: the force
+    /// solve's archive of the block's factored slots).
+    pub fn solve_transpose_static(&self, values: &[f64], scales: &Scales<'_>, x: &mut [f64]) {
+        let x = &mut x[..self.n()];
+        scale(x, scales.cols);
+        self.m.solve_transpose(self.stage, values, x);
+        scale(x, scales.rows);
+    }
+
     /// `x ← S⁻¹ x`.
     fn solve_scaled(&self, factors: Factors, storage: &FactorStorage<'_>, x: &mut [f64]) {
         let n = self.n();

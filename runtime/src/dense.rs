@@ -11,7 +11,8 @@ use core::cell::RefCell;
 use nalgebra::{DefaultAllocator, OVector, U1};
 
 use crate::mechanism::{
-    Accelerations, Matrix, Mechanism, Outputs, ParameterError, Storage, Unit, Vector, Velocities,
+    Accelerations, Forces, Matrix, Mechanism, Outputs, ParameterError, Storage, Unit, Vector,
+    Velocities,
 };
 use crate::structure::{Block, Pattern, Stage, Structured};
 use crate::workspace::{Parts, Workspace};
@@ -168,10 +169,33 @@ where
     fn gamma(&self, q: &Vector<M::Dim>, qd: &Vector<M::Dim>, t: f64, out: &mut Vector<M::Dim>) {
         self.inner.gamma(q, qd, t, out);
     }
+    fn generalized_forces(
+        &self,
+        q: &Vector<M::Dim>,
+        qd: &Vector<M::Dim>,
+        qdd: &Vector<M::Dim>,
+        t: f64,
+        out: &mut Vector<M::Dim>,
+    ) {
+        self.inner.generalized_forces(q, qd, qdd, t, out);
+    }
+    fn reactions(
+        &self,
+        q: &Vector<M::Dim>,
+        qd: &Vector<M::Dim>,
+        lambda: &[f64],
+        out: &mut Vector<M::Dim>,
+    ) {
+        self.inner.reactions(q, qd, lambda, out);
+    }
+    fn reaction_name(&self, index: usize) -> Option<&str> {
+        self.inner.reaction_name(index)
+    }
 }
 
 impl<M: Velocities> Velocities for Dense<M> where DefaultAllocator: Storage<M::Dim> {}
 impl<M: Accelerations> Accelerations for Dense<M> where DefaultAllocator: Storage<M::Dim> {}
+impl<M: Forces> Forces for Dense<M> where DefaultAllocator: Storage<M::Dim> {}
 
 impl<M: Mechanism> Structured for Dense<M>
 where
@@ -250,6 +274,25 @@ where
             copy(scratch.rhs.as_slice(), out);
         });
     }
+
+    /// The one block's force right-hand side is the whole of F: no later stage takes any up.
+    fn force_rhs(
+        &self,
+        _stage: usize,
+        q: &Vector<M::Dim>,
+        _trig: &[f64],
+        qd: &Vector<M::Dim>,
+        qdd: &Vector<M::Dim>,
+        _lambda: &[f64],
+        t: f64,
+        out: &mut [f64],
+    ) {
+        self.with_scratch(out, |scratch, out| {
+            self.inner
+                .generalized_forces(q, qd, qdd, t, &mut scratch.rhs);
+            copy(scratch.rhs.as_slice(), out);
+        });
+    }
 }
 
 /// `to ← from` over their common length.
@@ -273,6 +316,9 @@ where
     hints: [usize; 1],
     undetermined: OVector<usize, D>,
     downstream: [bool; 1],
+    /// The force solve's multipliers (the one block has no static factors to archive).
+    multipliers: Vector<D>,
+    archived: [bool; 1],
 }
 
 impl<D: nalgebra::Dim> DenseBuffers<D>
@@ -289,6 +335,8 @@ where
             hints: [usize::MAX],
             undetermined: OVector::from_element_generic(dim, U1, 0),
             downstream: [false],
+            multipliers: Vector::zeros_generic(dim, U1),
+            archived: [false],
         }
     }
 }
@@ -309,6 +357,7 @@ where
                 &mut self.downstream,
             ),
             &mut [],
+            (self.multipliers.as_mut_slice(), &mut self.archived),
         )
     }
 

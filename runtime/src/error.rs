@@ -33,6 +33,11 @@ pub enum Quantity {
     Acceleration,
     /// A branch invariant of the scene (its index).
     Branch(usize),
+    /// The generalised applied and inertial forces F of the force solve (a load's expression,
+    /// a spring of zero length, an overflowing inertia force).
+    Load,
+    /// The solved reactions (Lagrange multipliers) of the force solve.
+    Reaction,
 }
 
 impl Quantity {
@@ -59,6 +64,8 @@ impl Quantity {
             Self::Step => "the Newton step Δq",
             Self::Velocity => "the velocities q̇",
             Self::Acceleration => "the accelerations q̈",
+            Self::Load => "the applied and inertial forces F (loads, springs, masses)",
+            Self::Reaction => "the reactions (constraint forces and driver efforts)",
         };
         f.write_str(text)
     }

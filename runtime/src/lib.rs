@@ -59,6 +59,7 @@ mod block;
 mod crossing;
 mod dense;
 mod error;
+mod forces;
 mod geometry;
 mod lu;
 pub mod math;
@@ -67,6 +68,7 @@ mod origin;
 #[cfg(test)]
 mod pendulum;
 mod position;
+mod reactions;
 mod simulate;
 mod solver;
 mod state;
@@ -79,9 +81,10 @@ pub use error::{Described, Quantity, SolveError};
 pub use geometry::{GeometryFault, MAX_LENGTH, Requirement, check_geometry};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use mechanism::{
-    Accelerations, Matrix, Mechanism, Outputs, ParameterError, ParameterNames, Storage, Unit,
-    Vector, Velocities,
+    Accelerations, Forces, Matrix, Mechanism, Outputs, ParameterError, ParameterNames, Storage,
+    Unit, Vector, Velocities,
 };
+pub use reactions::{DistanceReaction, GroundLoad, PrismaticReaction, RevoluteReaction};
 pub use simulate::{DEFAULT_MAX_HALVINGS, Simulation, sample_time};
 pub use solver::{Convergence, Solver, SolverOptions};
 pub use state::{BodyState, Pose, PoseVelocity, State, write_csv_header};

@@ -106,6 +106,9 @@ pub enum Outputs {
     Velocities,
     /// Positions, velocities and accelerations q̈.
     Accelerations,
+    /// All three, and the forces that produce the motion: the reaction of every constraint
+    /// and the effort of every driver (inverse dynamics).
+    Forces,
 }
 
 /// Physical dimension of a coordinate or of an equation's value.
@@ -299,6 +302,48 @@ where
     ) {
         out.as_mut_slice().fill(f64::NAN);
     }
+
+    /// Writes the generalised applied and inertial forces `F = Q(q, q̇, t) − M q̈ − (velocity
+    /// terms)`, per coordinate: gravity, the scene's loads and springs, and the inertia of its
+    /// masses. The constraint forces balance them: `Φ_qᵀ λ = F` ([`Forces`]).
+    ///
+    /// Scenes that compute forces implement it; the default writes NaN.
+    fn generalized_forces(
+        &self,
+        _q: &Vector<Self::Dim>,
+        _qd: &Vector<Self::Dim>,
+        _qdd: &Vector<Self::Dim>,
+        _t: f64,
+        out: &mut Vector<Self::Dim>,
+    ) {
+        out.as_mut_slice().fill(f64::NAN);
+    }
+
+    /// Writes the reported reaction of every equation from the Lagrange multipliers `lambda`
+    /// (`Φ_qᵀ λ = F`) at positions `q` and velocities `qd`: for a revolute joint the force in world axes that its
+    /// second body exerts on its first, for a prismatic joint the normal force and the torque
+    /// on its first body, for a distance joint the tension, for a driver its effort, and for a
+    /// ground body the force (world axes) and torque (about its reference point) the mechanism
+    /// exerts on it through its joints, drivers and springs. [`Mechanism::reaction_name`] names
+    /// each.
+    ///
+    /// Scenes that compute forces implement it; the default writes NaN.
+    fn reactions(
+        &self,
+        _q: &Vector<Self::Dim>,
+        _qd: &Vector<Self::Dim>,
+        _lambda: &[f64],
+        out: &mut Vector<Self::Dim>,
+    ) {
+        out.as_mut_slice().fill(f64::NAN);
+    }
+
+    /// Name of the reaction [`Mechanism::reactions`] writes for equation `index`, such as
+    /// `"crank_pin.fx"` or `"crank_angle.effort"`; `None` past the end or for a scene that does
+    /// not compute forces.
+    fn reaction_name(&self, _index: usize) -> Option<&str> {
+        None
+    }
 }
 
 /// Marks a scene that computes velocities (implements [`Mechanism::nu`]): [`crate::State::qd`]
@@ -312,6 +357,17 @@ where
 
 /// Marks a scene that computes accelerations (implements [`Mechanism::gamma`]).
 pub trait Accelerations: Velocities
+where
+    DefaultAllocator: Storage<Self::Dim>,
+{
+}
+
+/// Marks a scene that computes forces (implements [`Mechanism::generalized_forces`],
+/// [`Mechanism::reactions`] and [`Mechanism::reaction_name`]): its mass properties, gravity and
+/// loads, with the solved motion, give the reaction of every constraint and the effort of
+/// every driver from one more linear solve with the transposed Jacobian, `Φ_qᵀ λ = F`.
+/// [`crate::State::constraint_forces`] exists only for such scenes.
+pub trait Forces: Accelerations
 where
     DefaultAllocator: Storage<Self::Dim>,
 {

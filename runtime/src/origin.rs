@@ -33,7 +33,7 @@ where
         (Some(q), Quantity::Phi),
         ((rates != Rates::None).then_some(qd), Quantity::Velocity),
         (
-            (rates == Rates::Both).then_some(qdd),
+            (rates >= Rates::Both).then_some(qdd),
             Quantity::Acceleration,
         ),
     ];

@@ -2,13 +2,14 @@
 //!
 //! One body, pinned at the origin at distance `a` from its reference point, its angle driven as
 //! `θ = ω t`: `x = a cos θ`, `y = a sin θ`. `duplicate_pin` replaces the driver with a copy of the
-//! first pin equation to make Φ_q singular on purpose.
+//! first pin equation to make Φ_q singular on purpose. With `mass` set it computes forces: a
+//! mass `m` with inertia `J` at its reference point, under gravity `(0, −g)`.
 
 use nalgebra::Const;
 
 use crate::math::{cos, sin};
 use crate::mechanism::{
-    Accelerations, Matrix, Mechanism, Outputs, ParameterError, Unit, Vector, Velocities,
+    Accelerations, Forces, Matrix, Mechanism, Outputs, ParameterError, Unit, Vector, Velocities,
 };
 
 #[derive(Debug, Clone)]
@@ -16,6 +17,8 @@ pub struct Pendulum {
     pub a: f64,
     pub omega: f64,
     pub duplicate_pin: bool,
+    /// `(m, J, g)`: mass, inertia and gravity, for the force solve.
+    pub mass: Option<(f64, f64, f64)>,
 }
 
 impl Default for Pendulum {
@@ -24,6 +27,7 @@ impl Default for Pendulum {
             a: 2.0,
             omega: 1.5,
             duplicate_pin: false,
+            mass: None,
         }
     }
 }
@@ -113,7 +117,11 @@ impl Mechanism for Pendulum {
     }
 
     fn outputs(&self) -> Outputs {
-        Outputs::Accelerations
+        if self.mass.is_some() {
+            Outputs::Forces
+        } else {
+            Outputs::Accelerations
+        }
     }
 
     fn nu(&self, _: &Vector<Const<3>>, _: f64, out: &mut Vector<Const<3>>) {
@@ -131,10 +139,54 @@ impl Mechanism for Pendulum {
         let w2 = thd * thd;
         *out = Vector::from([-self.a * cos(th) * w2, -self.a * sin(th) * w2, 0.0]);
     }
+
+    fn generalized_forces(
+        &self,
+        _: &Vector<Const<3>>,
+        _: &Vector<Const<3>>,
+        qdd: &Vector<Const<3>>,
+        _: f64,
+        out: &mut Vector<Const<3>>,
+    ) {
+        let (m, j, g) = self.mass.unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+        *out = Vector::from([-m * qdd.x, m * (-g - qdd.y), -j * qdd.z]);
+    }
+
+    /// The pin's force on the rod (`pin` is `revolute(rod @ (−a, 0), ground)`) and the drive's
+    /// torque.
+    fn reactions(
+        &self,
+        _: &Vector<Const<3>>,
+        _: &Vector<Const<3>>,
+        lambda: &[f64],
+        out: &mut Vector<Const<3>>,
+    ) {
+        for (o, l) in out.iter_mut().zip(lambda) {
+            *o = -l;
+        }
+    }
+
+    fn reaction_name(&self, index: usize) -> Option<&str> {
+        ["pin.fx", "pin.fy", "drive.effort"].get(index).copied()
+    }
 }
 
 impl Velocities for Pendulum {}
 impl Accelerations for Pendulum {}
+impl Forces for Pendulum {}
+
+impl Pendulum {
+    /// Closed-form reactions at `t` (with `mass` set): the pin carries `m (a_c − g)`, the
+    /// driver turns the rod against the pin force's moment (θ̈ = 0).
+    pub fn exact_reactions(&self, t: f64) -> [f64; 3] {
+        let (m, _, g) = self.mass.unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+        let [q, _, qdd] = self.exact(t);
+        let pin = [m * qdd[0], m * (qdd[1] + g)];
+        // The pin is at A(θ) (−a, 0) from the reference point: τ = −(r × F).
+        let r = [-self.a * cos(q[2]), -self.a * sin(q[2])];
+        [pin[0], pin[1], -(r[0] * pin[1] - r[1] * pin[0])]
+    }
+}
 
 /// The same pendulum behind a `Dyn` dimension, as the interpreter would present it.
 #[cfg(feature = "alloc")]

@@ -392,7 +392,7 @@ where
                 *g = q + h * v;
             }
         }
-        Outputs::Accelerations => {
+        Outputs::Accelerations | Outputs::Forces => {
             let c = if history {
                 h * h * h / (6.0 * h_prev)
             } else {

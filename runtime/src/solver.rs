@@ -8,6 +8,7 @@ use nalgebra::{DefaultAllocator, Dim};
 
 use crate::block::{BlockSolve, Factors};
 use crate::error::{Described, Quantity, SolveError};
+use crate::forces;
 use crate::lu::DEFAULT_PIVOT_TOLERANCE;
 use crate::mechanism::{Accelerations, LengthScale, Outputs, Storage, Vector, Velocities};
 use crate::origin;
@@ -255,12 +256,15 @@ where
     }
 }
 
-/// What a stage sweep computes besides positions.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// What a stage sweep computes besides positions: ordered, each level including the ones
+/// before it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub(crate) enum Rates {
     None,
     Velocities,
     Both,
+    /// Both rates, then the force solve in reverse.
+    Forces,
 }
 
 impl Rates {
@@ -269,6 +273,7 @@ impl Rates {
             Outputs::Positions => Rates::None,
             Outputs::Velocities => Rates::Velocities,
             Outputs::Accelerations => Rates::Both,
+            Outputs::Forces => Rates::Forces,
         }
     }
 }
@@ -366,13 +371,16 @@ where
 
     /// Solves positions starting from `state.q`, and the derivatives the scene provides, into
     /// `state`, stage by stage: each block's velocities and accelerations are solved with the
-    /// factors its Newton iteration ends with. On error `state` is partly updated.
+    /// factors its Newton iteration ends with. A scene that computes forces then solves
+    /// `Φ_qᵀ λ = F` with the same factors, stage by stage in reverse, into the state's
+    /// reactions ([`crate::Forces`]). On error `state` is partly updated.
     ///
     /// # Errors
-    /// Any [`SolveError`] of the position, velocity or acceleration solve.
+    /// Any [`SolveError`] of the position, velocity, acceleration or force solve.
     pub fn solve_into(&mut self, t: f64, state: &mut State<M>) -> Result<(), SolveError> {
         self.check_len(&state.velocities)?;
         self.check_len(&state.accelerations)?;
+        self.check_len(&state.reactions)?;
         let rates = Rates::of(self.mechanism.outputs());
         let convergence = self.solve_stages(
             t,
@@ -380,6 +388,7 @@ where
             &mut state.velocities,
             &mut state.accelerations,
             rates,
+            Some(&mut state.reactions),
         )?;
         state.t = t;
         state.iterations = convergence.iterations;
@@ -411,7 +420,7 @@ where
         t: f64,
     ) -> Result<Convergence, SolveError> {
         let (mut qd, mut qdd) = (q.clone(), q.clone());
-        self.solve_stages(t, q, &mut qd, &mut qdd, Rates::None)
+        self.solve_stages(t, q, &mut qd, &mut qdd, Rates::None, None)
     }
 
     /// The stage sweep of [`Solver::solve_into`] and [`Solver::solve_position`], with a
@@ -423,15 +432,18 @@ where
         qd: &mut Vector<M::Dim>,
         qdd: &mut Vector<M::Dim>,
         rates: Rates,
+        reactions: Option<&mut Vector<M::Dim>>,
     ) -> Result<Convergence, SolveError> {
         self.check_inputs(t, q, Quantity::Guess)?;
         self.check_parameters(t)?;
         let mut reached = 0;
-        self.sweep(t, q, qd, qdd, rates, &mut reached)
+        self.sweep(t, q, qd, qdd, rates, reactions, &mut reached)
             .map_err(|e| origin::trace(&self.mechanism, reached, [q, qd, qdd], rates, e))
     }
 
-    /// Solves the stages in order, recording in `reached` the stage being solved.
+    /// Solves the stages in order, recording in `reached` the stage being solved, then, for
+    /// [`Rates::Forces`], the force solve in reverse into `reactions`.
+    #[allow(clippy::too_many_arguments)]
     fn sweep(
         &mut self,
         t: f64,
@@ -439,6 +451,7 @@ where
         qd: &mut Vector<M::Dim>,
         qdd: &mut Vector<M::Dim>,
         rates: Rates,
+        reactions: Option<&mut Vector<M::Dim>>,
         reached: &mut usize,
     ) -> Result<Convergence, SolveError> {
         self.update_scale();
@@ -452,6 +465,8 @@ where
         } = self;
         let mut parts = workspace.parts();
         let mut total = Convergence::start(options.estimate_condition);
+        // How much of the force solve's archive the blocks have filled.
+        let mut archived = 0;
         for s in 0..m.stage_count() {
             *reached = s;
             match m.stage(s) {
@@ -479,6 +494,11 @@ where
                         t,
                         rates,
                     )?;
+                    if rates == Rates::Forces {
+                        let n = q.len();
+                        archived =
+                            forces::archive(&newton.bs, solved.factors, newton.parts, n, archived);
+                    }
                 }
                 None => break,
             }
@@ -489,6 +509,10 @@ where
         check_finite(q, t, Quantity::Phi)?;
         check_rates(qd, qdd, t, rates)?;
         check_branches(m, q, parts.trig, t)?;
+        if let (Rates::Forces, Some(reactions)) = (rates, reactions) {
+            let motion = forces::Motion { t, q, qd, qdd };
+            forces::solve(m, &mut parts, options, length, &motion, archived, reactions)?;
+        }
         Ok(total)
     }
 
@@ -822,7 +846,7 @@ fn assign_rates<M: Structured>(
     if rates != Rates::None {
         m.assign_velocities(stage, q, trig, qd, t);
     }
-    if rates == Rates::Both {
+    if rates >= Rates::Both {
         m.assign_accelerations(stage, q, trig, qd, qdd, t);
     }
 }
@@ -840,7 +864,7 @@ where
     if rates != Rates::None {
         check_finite(qd, t, Quantity::Velocity)?;
     }
-    if rates == Rates::Both {
+    if rates >= Rates::Both {
         check_finite(qdd, t, Quantity::Acceleration)?;
     }
     Ok(())
@@ -870,7 +894,7 @@ where
     check_rhs(bs, rhs, t, Quantity::Nu)?;
     bs.solve(factors, &parts.factors, &parts.scales, rhs);
     scatter(rhs, bs.block.coordinates, qd, t, Quantity::Velocity)?;
-    if rates == Rates::Both {
+    if rates >= Rates::Both {
         bs.m.acceleration_rhs(bs.stage, q, parts.trig, qd, qdd, t, rhs);
         check_rhs(bs, rhs, t, Quantity::Gamma)?;
         bs.solve(factors, &parts.factors, &parts.scales, rhs);
@@ -1082,7 +1106,7 @@ mod tests {
             q[2] += nudge;
             let (mut qd, mut qdd) = (q, q);
             let convergence = solver
-                .solve_stages(0.7, &mut q, &mut qd, &mut qdd, Rates::Both)
+                .solve_stages(0.7, &mut q, &mut qd, &mut qdd, Rates::Both, None)
                 .unwrap();
             (convergence.iterations, convergence.evaluations)
         };

@@ -5,7 +5,7 @@ use core::marker::PhantomData;
 
 use nalgebra::{DefaultAllocator, Dim};
 
-use crate::mechanism::{Accelerations, Mechanism, Outputs, Storage, Vector, Velocities};
+use crate::mechanism::{Accelerations, Forces, Mechanism, Outputs, Storage, Vector, Velocities};
 
 /// Positions (and the derivatives the scene provides) of a mechanism at time `t`.
 ///
@@ -58,6 +58,8 @@ where
     pub(crate) velocities: Vector<M::Dim>,
     /// Accelerations q̈ (zero unless the scene computes them).
     pub(crate) accelerations: Vector<M::Dim>,
+    /// The reaction of every equation (zero unless the scene computes forces).
+    pub(crate) reactions: Vector<M::Dim>,
     /// Newton updates the position solve needed: the most any block needed (summed over
     /// sub-steps, if any).
     pub iterations: usize,
@@ -165,6 +167,7 @@ where
             q: Vector::zeros_generic(dim, nalgebra::U1),
             velocities: Vector::zeros_generic(dim, nalgebra::U1),
             accelerations: Vector::zeros_generic(dim, nalgebra::U1),
+            reactions: Vector::zeros_generic(dim, nalgebra::U1),
             iterations: 0,
             substeps: 0,
             condition: f64::NAN,
@@ -183,6 +186,7 @@ where
         self.q.copy_from(&other.q);
         self.velocities.copy_from(&other.velocities);
         self.accelerations.copy_from(&other.accelerations);
+        self.reactions.copy_from(&other.reactions);
         self.iterations = other.iterations;
         self.substeps = other.substeps;
         self.condition = other.condition;
@@ -203,8 +207,9 @@ where
         Some(Pose { x, y, theta })
     }
 
-    /// Writes `t`, then q (and q̇, q̈ when the scene computes them) as one CSV line ending in
-    /// `\n`, matching [`write_csv_header`].
+    /// Writes `t`, then q (and q̇, q̈ when the scene computes them, and the reaction of every
+    /// equation when it computes forces) as one CSV line ending in `\n`, matching
+    /// [`write_csv_header`].
     ///
     /// Numbers are the shortest strings that parse back to the same value, with an exponent
     /// for tiny and huge magnitudes (`5.2e-30`). A NaN or infinity (which a successful solve
@@ -214,7 +219,12 @@ where
     /// Whatever `out` returns.
     pub fn write_csv_row<W: Write>(&self, out: &mut W) -> fmt::Result {
         write!(out, "{:?}", self.t)?;
-        let columns = [&self.q, &self.velocities, &self.accelerations];
+        let columns = [
+            &self.q,
+            &self.velocities,
+            &self.accelerations,
+            &self.reactions,
+        ];
         for column in columns.iter().take(column_groups(self.outputs)) {
             for value in column.as_slice() {
                 write!(out, ",{value:?}")?;
@@ -276,19 +286,34 @@ where
     }
 }
 
-/// Number of CSV column groups (q; q, q̇; q, q̇, q̈) for a scene's outputs.
+impl<M: Forces> State<M>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    /// The reaction of every equation, in Φ order ([`Mechanism::reactions`] says what each is
+    /// and [`Mechanism::reaction_name`] names it): the scene's generated `reactions()` and
+    /// `efforts()` read them by name.
+    pub fn constraint_forces(&self) -> &Vector<M::Dim> {
+        &self.reactions
+    }
+}
+
+/// Number of CSV column groups (q; q, q̇; q, q̇, q̈; and the reactions) for a scene's outputs.
 fn column_groups(outputs: Outputs) -> usize {
     match outputs {
         Outputs::Positions => 1,
         Outputs::Velocities => 2,
         Outputs::Accelerations => 3,
+        Outputs::Forces => 4,
     }
 }
 
 /// Writes the CSV header line: `t`, every coordinate name, then (when the scene computes them)
-/// the names with `_dot`, then with `_ddot` (`t,piston.x,…,piston.x_dot,…,piston.x_ddot,…\n`).
+/// the names with `_dot`, then with `_ddot` (`t,piston.x,…,piston.x_dot,…,piston.x_ddot,…\n`),
+/// then, when it computes forces, every equation's reaction by its
+/// [`Mechanism::reaction_name`] (`crank_pin.fx`, …, `crank_angle.effort`).
 ///
-/// A coordinate without a name is written as `q<index>`.
+/// A coordinate without a name is written as `q<index>`, a reaction as `reaction<index>`.
 ///
 /// # Errors
 /// Whatever `out` returns.
@@ -298,12 +323,21 @@ where
 {
     out.write_char('t')?;
     let n = mechanism.dim().value();
+    let groups = column_groups(mechanism.outputs());
     let suffixes = ["", "_dot", "_ddot"];
-    for suffix in suffixes.iter().take(column_groups(mechanism.outputs())) {
+    for suffix in suffixes.iter().take(groups) {
         for index in 0..n {
             match mechanism.coordinate_name(index) {
                 Some(name) => write!(out, ",{name}{suffix}")?,
                 None => write!(out, ",q{index}{suffix}")?,
+            }
+        }
+    }
+    if groups > suffixes.len() {
+        for index in 0..n {
+            match mechanism.reaction_name(index) {
+                Some(name) => write!(out, ",{name}")?,
+                None => write!(out, ",reaction{index}")?,
             }
         }
     }
@@ -320,6 +354,7 @@ where
             q: self.q.clone(),
             velocities: self.velocities.clone(),
             accelerations: self.accelerations.clone(),
+            reactions: self.reactions.clone(),
             iterations: self.iterations,
             substeps: self.substeps,
             condition: self.condition,
@@ -343,6 +378,7 @@ where
             .field("q", &self.q.as_slice())
             .field("qd", &self.velocities.as_slice())
             .field("qdd", &self.accelerations.as_slice())
+            .field("reactions", &self.reactions.as_slice())
             .field("iterations", &self.iterations)
             .field("substeps", &self.substeps)
             .field("condition", &self.condition)
@@ -354,9 +390,10 @@ where
     }
 }
 
-/// `{"t", "q", "q_dot", "q_ddot", "iterations", "evaluations", "substeps", "condition",
-/// "fallbacks", "det_sign"}`, with `q_dot` and `q_ddot` only for scenes that compute them (as the
-/// CSV columns) and `condition` `null` when not estimated (serde_json writes NaN as `null`).
+/// `{"t", "q", "q_dot", "q_ddot", "reactions", "iterations", "evaluations", "substeps",
+/// "condition", "fallbacks", "det_sign"}`, with `q_dot`, `q_ddot` and `reactions` only for
+/// scenes that compute them (as the CSV columns) and `condition` `null` when not estimated
+/// (serde_json writes NaN as `null`).
 #[cfg(feature = "serde")]
 impl<M: Mechanism> serde::Serialize for State<M>
 where
@@ -377,6 +414,11 @@ where
             s.serialize_field("q_ddot", self.accelerations.as_slice())?;
         } else {
             s.skip_field("q_ddot")?;
+        }
+        if groups >= 4 {
+            s.serialize_field("reactions", self.reactions.as_slice())?;
+        } else {
+            s.skip_field("reactions")?;
         }
         s.serialize_field("iterations", &self.iterations)?;
         s.serialize_field("evaluations", &self.evaluations)?;

@@ -224,4 +224,51 @@ where
     ) {
         out.fill(f64::NAN);
     }
+
+    /// Writes the Lagrange multipliers of an explicit stage's equations into `lambda` (indexed
+    /// by equation), from the multipliers of later stages already there: each assignment's
+    /// equation balances the generalised force on its coordinate,
+    /// `λ_e = (F_c − Σ_{later} Φ_q[i, c] λ_i) / Φ_q[e, c]` ([`crate::Forces`]).
+    ///
+    /// Scenes that compute forces implement it; the default writes NaN.
+    #[allow(clippy::too_many_arguments)]
+    fn assign_multipliers(
+        &self,
+        stage: usize,
+        _q: &Vector<Self::Dim>,
+        _trig: &[f64],
+        _qd: &Vector<Self::Dim>,
+        _qdd: &Vector<Self::Dim>,
+        lambda: &mut [f64],
+        _t: f64,
+    ) {
+        if let Some(Stage::Explicit { equations, .. }) = self.stage(stage) {
+            for &e in equations {
+                if let Some(l) = lambda.get_mut(e) {
+                    *l = f64::NAN;
+                }
+            }
+        }
+    }
+
+    /// Writes a block's force right-hand side, in local column order: the generalised force
+    /// on each of its coordinates less what the constraints of later stages take up,
+    /// `F_c − Σ_{later} Φ_q[i, c] λ_i`, from the multipliers of later stages in `lambda`. The
+    /// block's multipliers solve `Φ_q[b, b]ᵀ λ_b = out` ([`Structured::solve_transpose`]).
+    ///
+    /// Scenes that compute forces implement it; the default writes NaN.
+    #[allow(clippy::too_many_arguments)]
+    fn force_rhs(
+        &self,
+        _stage: usize,
+        _q: &Vector<Self::Dim>,
+        _trig: &[f64],
+        _qd: &Vector<Self::Dim>,
+        _qdd: &Vector<Self::Dim>,
+        _lambda: &[f64],
+        _t: f64,
+        out: &mut [f64],
+    ) {
+        out.fill(f64::NAN);
+    }
 }

@@ -1,7 +1,8 @@
 //! The solver's scratch storage, sized by the scene: vectors of the largest block's size, the
 //! largest block's factor values, two dense matrices of the largest block's size (the partial
-//! pivoting fallback and Levenberg–Marquardt), a word per stage, the trig cache, and one index
-//! per coordinate for a diagnosis.
+//! pivoting fallback and Levenberg–Marquardt), a word per stage, the trig cache, one index per
+//! coordinate for a diagnosis, and, for a scene that computes forces, the force solve's
+//! multipliers and the archive of its blocks' factors (see `forces.rs`).
 //!
 //! Nothing here grows with the square of the scene: the 1000-stage scissor lift (6,012
 //! coordinates, largest block 6) needs 90 kB, where one dense Jacobian would need 289 MB.
@@ -40,6 +41,11 @@ pub struct Parts<'a> {
     pub(crate) downstream: &'a mut [bool],
     /// The trig cache ([`crate::Structured::fill_trig`]).
     pub(crate) trig: &'a mut [f64],
+    /// The force solve's storage (empty unless the scene computes forces): one multiplier per
+    /// equation, then the static factors of the blocks the forward sweep archived.
+    pub(crate) forces: &'a mut [f64],
+    /// Per stage: whether its block's static factors are in the archive (K).
+    pub(crate) archived: &'a mut [bool],
 }
 
 /// The Newton iteration's vectors (B each).
@@ -98,6 +104,7 @@ impl<'a> Parts<'a> {
         [lu, dense]: [&'a mut [f64]; 2],
         (hints, undetermined, downstream): (&'a mut [usize], &'a mut [usize], &'a mut [bool]),
         trig: &'a mut [f64],
+        (forces, archived): (&'a mut [f64], &'a mut [bool]),
     ) -> Self {
         Parts {
             newton: NewtonVectors {
@@ -121,15 +128,26 @@ impl<'a> Parts<'a> {
             undetermined,
             downstream,
             trig,
+            forces,
+            archived,
         }
     }
 }
 
 /// Inline storage for a scene of `N` coordinates whose largest block has `B` coordinates and
-/// `S` factor values, solved in `K` stages with `T` cached sines and cosines: what generated
-/// code names as its [`crate::Structured::Workspace`].
+/// `S` factor values, solved in `K` stages with `T` cached sines and cosines, and `R` values
+/// for the force solve (0 unless the scene computes forces: `N` multipliers, then the static
+/// factor values of every block): what generated code names as its
+/// [`crate::Structured::Workspace`].
 #[derive(Debug, Clone)]
-pub struct Buffers<const B: usize, const S: usize, const K: usize, const N: usize, const T: usize> {
+pub struct Buffers<
+    const B: usize,
+    const S: usize,
+    const K: usize,
+    const N: usize,
+    const T: usize,
+    const R: usize = 0,
+> {
     vectors: [[f64; B]; 10],
     indices: [[usize; B]; 3],
     values: [f64; S],
@@ -138,10 +156,12 @@ pub struct Buffers<const B: usize, const S: usize, const K: usize, const N: usiz
     undetermined: [usize; N],
     downstream: [bool; K],
     trig: [f64; T],
+    forces: [f64; R],
+    archived: [bool; K],
 }
 
-impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: usize>
-    Buffers<B, S, K, N, T>
+impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: usize, const R: usize>
+    Buffers<B, S, K, N, T, R>
 {
     /// Zeroed buffers.
     pub const fn new() -> Self {
@@ -154,20 +174,22 @@ impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: us
             undetermined: [0; N],
             downstream: [false; K],
             trig: [0.0; T],
+            forces: [0.0; R],
+            archived: [false; K],
         }
     }
 }
 
-impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: usize> Default
-    for Buffers<B, S, K, N, T>
+impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: usize, const R: usize>
+    Default for Buffers<B, S, K, N, T, R>
 {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: usize> Workspace
-    for Buffers<B, S, K, N, T>
+impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: usize, const R: usize>
+    Workspace for Buffers<B, S, K, N, T, R>
 {
     fn parts(&mut self) -> Parts<'_> {
         let [lu, dense] = &mut self.matrices;
@@ -182,6 +204,7 @@ impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: us
                 &mut self.downstream,
             ),
             &mut self.trig,
+            (&mut self.forces, &mut self.archived),
         )
     }
 
@@ -202,13 +225,23 @@ pub struct VecBuffers {
     undetermined: alloc::vec::Vec<usize>,
     downstream: alloc::vec::Vec<bool>,
     trig: alloc::vec::Vec<f64>,
+    forces: alloc::vec::Vec<f64>,
+    archived: alloc::vec::Vec<bool>,
 }
 
 #[cfg(feature = "alloc")]
 impl VecBuffers {
     /// Buffers for a scene of `n` coordinates whose blocks have up to `block` coordinates and
-    /// `slots` factor values, in `stages` stages, with `trig` cached sines and cosines.
-    pub fn new(block: usize, slots: usize, stages: usize, n: usize, trig: usize) -> Self {
+    /// `slots` factor values, in `stages` stages, with `trig` cached sines and cosines and
+    /// `forces` values for the force solve (0 unless the scene computes forces).
+    pub fn new(
+        block: usize,
+        slots: usize,
+        stages: usize,
+        n: usize,
+        trig: usize,
+        forces: usize,
+    ) -> Self {
         use alloc::vec;
         Self {
             vectors: core::array::from_fn(|_| vec![0.0; block]),
@@ -219,6 +252,8 @@ impl VecBuffers {
             undetermined: vec![0; n],
             downstream: vec![false; stages],
             trig: vec![0.0; trig],
+            forces: vec![0.0; forces],
+            archived: vec![false; stages],
         }
     }
 }
@@ -237,6 +272,7 @@ impl Workspace for VecBuffers {
                 &mut self.downstream,
             ),
             &mut self.trig,
+            (&mut self.forces, &mut self.archived),
         )
     }
 

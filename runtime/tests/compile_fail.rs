@@ -8,5 +8,5 @@
 #[test]
 fn diagnostics() {
     let cases = trybuild::TestCases::new();
-    cases.compile_fail("ui/*.rs");
+    cases.compile_fail("tests/ui/*.rs");
 }

@@ -1,7 +1,8 @@
 //! `mechgen solve` on a scene's `.mech` file (interpreter + runtime solver) against the same
-//! scene compiled by `mechanism!` (generated code + the same solver): equal to round-off.
+//! scene compiled by `mechanism!` (generated code + the same solver): equal to round-off, the
+//! force solve's reactions included.
 
-use mechgen_examples::scenes::{FourBar, PistonCrank};
+use mechgen_examples::scenes::{FourBar, PistonCrank, PistonCrankDynamics};
 use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{Simulation, Solver, Structured, write_csv_header};
 
@@ -54,16 +55,17 @@ fn parse(csv: &str) -> (Vec<String>, Vec<Vec<f64>>) {
 }
 
 /// Same header, same times to the bit, and every value equal to 1e-12 of the largest magnitude
-/// of its quantity (q, q̇ or q̈) over the motion: columns that are zero in exact arithmetic hold
-/// round-off noise, so a per-column scale would be meaningless.
-fn assert_round_off_equal(cli: &str, generated: &str) {
+/// of its quantity (q, q̇, q̈ or the reactions: `groups` of them) over the motion: columns that
+/// are zero in exact arithmetic hold round-off noise, so a per-column scale would be
+/// meaningless.
+fn assert_round_off_equal(cli: &str, generated: &str, groups: usize) {
     let (cli_header, cli_rows) = parse(cli);
     let (gen_header, gen_rows) = parse(generated);
     assert_eq!(cli_header, gen_header);
     assert_eq!(cli_rows.len(), gen_rows.len());
-    let n = (cli_header.len() - 1) / 3;
+    let n = (cli_header.len() - 1) / groups;
     let quantity = |column: usize| (column.max(1) - 1) / n;
-    let mut scales = [0.0f64; 3];
+    let mut scales = vec![0.0f64; groups];
     for row in &gen_rows {
         for (column, value) in row.iter().enumerate().skip(1) {
             scales[quantity(column)] = scales[quantity(column)].max(value.abs());
@@ -95,7 +97,20 @@ fn seed_cli_matches_generated_code() {
     let period = 2.0 * std::f64::consts::PI / 314.0;
     let cli = cli_solve("piston_crank.mech", period, 360);
     let generated = macro_solve(PistonCrank::default(), period, 360);
-    assert_round_off_equal(&cli, &generated);
+    assert_round_off_equal(&cli, &generated, 3);
+}
+
+#[test]
+fn seed_forces_cli_matches_generated_code() {
+    let period = 2.0 * std::f64::consts::PI / 314.0;
+    let cli = cli_solve("piston_crank_dynamics.mech", period, 360);
+    let generated = macro_solve(PistonCrankDynamics::default(), period, 360);
+    assert!(
+        cli.lines()
+            .next()
+            .is_some_and(|h| h.ends_with("crank_angle.effort"))
+    );
+    assert_round_off_equal(&cli, &generated, 4);
 }
 
 #[test]
@@ -103,5 +118,5 @@ fn four_bar_cli_matches_generated_code() {
     let period = 2.0 * std::f64::consts::PI / 10.0;
     let cli = cli_solve("four_bar.mech", period, 180);
     let generated = macro_solve(FourBar::default(), period, 180);
-    assert_round_off_equal(&cli, &generated);
+    assert_round_off_equal(&cli, &generated, 3);
 }

@@ -72,6 +72,58 @@ fn the_full_scenes_keep_every_output() {
     }
 }
 
+/// The force solve's items, which only a scene that computes forces gets.
+const FORCE_ITEMS: [&str; 10] = [
+    "Forces",
+    "generalized_forces",
+    "reactions",
+    "reaction_name",
+    "REACTIONS",
+    "assign_multipliers",
+    "force_rhs",
+    "lambda",
+    "PistonCrankForces",
+    "constraint_forces",
+];
+
+#[test]
+fn a_scene_without_masses_or_loads_has_no_force_code() {
+    let words = words(&expanded("piston_crank.mech"));
+    for absent in FORCE_ITEMS {
+        assert!(!words.iter().any(|w| w == absent), "`{absent}` generated");
+    }
+    // Its workspace has no force storage: the type is the one without the sixth size.
+    let code = expanded("piston_crank.mech").replace(' ', "");
+    assert!(
+        code.contains("Buffers<2,4,4,15,4>"),
+        "workspace type changed"
+    );
+}
+
+#[test]
+fn masses_without_the_forces_output_generate_no_force_code() {
+    let source = scene_source("piston_crank_dynamics.mech").replace(
+        "gravity (0, -9810);",
+        "gravity (0, -9810);\n    outputs positions, velocities, accelerations;",
+    );
+    let tokens: proc_macro2::TokenStream = source.parse().expect("lexes");
+    let code = mechgen::expand(tokens).unwrap_or_else(|e| panic!("{e}"));
+    let words = words(&code.to_string());
+    for absent in FORCE_ITEMS {
+        assert!(!words.iter().any(|w| w == absent), "`{absent}` generated");
+    }
+    // Declared masses default to the forces output.
+    let words = self::words(&expanded("piston_crank_dynamics.mech"));
+    for present in [
+        "Forces",
+        "generalized_forces",
+        "force_rhs",
+        "assign_multipliers",
+    ] {
+        assert!(words.iter().any(|w| w == present), "`{present}` missing");
+    }
+}
+
 #[test]
 fn ground_bodies_contribute_no_trigonometry() {
     // The seed's grounds are `liner` and `bearing`: no sin/cos of their angles anywhere.

@@ -1,6 +1,6 @@
 //! Generated code through the runtime allocates nothing: positions, velocities and
-//! accelerations of the seed over many steps, sub-stepping, every error path with its
-//! description, and CSV output.
+//! accelerations of the seed over many steps, the force solve (reactions and driver efforts),
+//! sub-stepping, every error path with its description, and CSV output.
 //!
 //! A counting global allocator wraps the system one. This file holds a single test so that no
 //! other test thread allocates while it counts.
@@ -11,7 +11,9 @@ use core::fmt::{self, Write};
 use core::sync::atomic::{AtomicUsize, Ordering};
 use std::alloc::System;
 
-use mechgen_examples::scenes::{FourBar, PistonCrank, PistonCrankBodies};
+use mechgen_examples::scenes::{
+    FourBar, PistonCrank, PistonCrankBodies, PistonCrankDynamics, PistonCrankDynamicsForces,
+};
 use mechgen_examples::stability::{
     self, FlexiblePistonCrank, Parallelogram, SliderCrank, Unclosable,
 };
@@ -97,6 +99,20 @@ fn generated_scenes_solve_without_allocating() {
 
     let mut four_bar = Simulation::new(Solver::new(FourBar::default()), 0.0).expect("four-bar");
     four_bar.run(1.0, 1_000, |_| {}).expect("four-bar solves");
+
+    // The force solve: reactions and efforts at every step, by name and as CSV columns.
+    let mut dynamics =
+        Simulation::new(Solver::new(PistonCrankDynamics::default()), 0.0).expect("dynamics");
+    let mut peak_torque = 0.0f64;
+    dynamics
+        .run(0.05, 1_000, |state| {
+            let pin = state.reactions().crank_pin;
+            peak_torque = peak_torque.max(state.efforts().crank_angle.abs());
+            assert!(pin.fx.is_finite() && pin.fy.is_finite());
+            state.write_csv_row(&mut sink).expect("sink never fails");
+        })
+        .expect("dynamics solves");
+    assert!(peak_torque > 0.0);
 
     // Every safeguard and failure of the stability work: sub-stepping a coarse step, the
     // Levenberg–Marquardt fallback ending in NoAssembly, the rank-revealing diagnosis of a

@@ -592,6 +592,7 @@ where
                 qd: &[],
                 qdd: &[],
                 trig: &[],
+                lambda: &[],
                 t,
                 params,
             };
@@ -657,6 +658,7 @@ where
             qd: &[],
             qdd: &[],
             trig: &[],
+            lambda: &[],
             t,
             params: &self.params,
         };

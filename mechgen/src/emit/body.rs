@@ -30,8 +30,20 @@ pub(super) struct Args {
     pub q: Ident,
     pub qd: Ident,
     pub qdd: Ident,
+    pub lambda: Ident,
     pub trig: Ident,
     pub t: Ident,
+}
+
+/// Which inputs a body reads.
+#[derive(Debug, Clone, Copy, Default)]
+pub(super) struct Reads {
+    pub q: bool,
+    pub qd: bool,
+    pub qdd: bool,
+    pub lambda: bool,
+    pub trig: bool,
+    pub t: bool,
 }
 
 /// No cached nodes: every node is computed.
@@ -40,8 +52,8 @@ pub(super) fn computed() -> HashMap<Id, usize> {
 }
 
 impl Args {
-    /// `q`, `qd`, `qdd`, `trig`, `t`, each with a leading underscore when not read.
-    pub fn named(q: bool, qd: bool, qdd: bool, trig: bool, t: bool) -> Self {
+    /// `q`, `qd`, `qdd`, `lambda`, `trig`, `t`, each with a leading underscore when not read.
+    pub fn named(reads: Reads) -> Self {
         let arg = |used: bool, name: &str| {
             if used {
                 format_ident!("{}", name)
@@ -50,19 +62,21 @@ impl Args {
             }
         };
         Args {
-            q: arg(q, "q"),
-            qd: arg(qd, "qd"),
-            qdd: arg(qdd, "qdd"),
-            trig: arg(trig, "trig"),
-            t: arg(t, "t"),
+            q: arg(reads.q, "q"),
+            qd: arg(reads.qd, "qd"),
+            qdd: arg(reads.qdd, "qdd"),
+            lambda: arg(reads.lambda, "lambda"),
+            trig: arg(reads.trig, "trig"),
+            t: arg(reads.t, "t"),
         }
     }
 
-    /// The name of input `q`, `qd`, `qdd`, `trig` or `t`.
+    /// The name of input `q`, `qd`, `qdd`, `lambda`, `trig` or `t`.
     pub fn get(&self, input: &str) -> &Ident {
         match input {
             "qd" => &self.qd,
             "qdd" => &self.qdd,
+            "lambda" => &self.lambda,
             "trig" => &self.trig,
             "t" => &self.t,
             _ => &self.q,
@@ -83,8 +97,12 @@ impl Function {
 
 pub(super) struct Context<'a> {
     pub model: &'a Model,
+    /// The model's equation names, for naming multipliers (`lambda_crank_pin_x`).
+    pub equations: Vec<String>,
     /// The branch invariants' values (from the kinematics).
     pub kinematics_branches: &'a [Id],
+    /// The force solve, for a scene that computes forces.
+    pub forces: Option<&'a crate::reactions::Forces>,
     pub options: &'a CodegenOptions,
     /// Helper functions of split bodies, emitted in an inherent `impl` block.
     pub helpers: RefCell<Vec<TokenStream>>,
@@ -162,7 +180,14 @@ impl Context<'_> {
             |i: &str| inputs.iter().any(|(n, _)| *n == i) || outs.iter().any(|(o, _)| *o == i);
         Function {
             body: quote! { #clear #(#calls)* },
-            args: Args::named(used("q"), used("qd"), used("qdd"), used("trig"), true),
+            args: Args::named(Reads {
+                q: used("q"),
+                qd: used("qd"),
+                qdd: used("qdd"),
+                lambda: used("lambda"),
+                trig: used("trig"),
+                t: true,
+            }),
             counts,
         }
     }
@@ -244,7 +269,7 @@ impl Context<'_> {
         let mut loads: Vec<(Var, TokenStream)> = Vec::new();
         let mut trig_loads: Vec<(usize, TokenStream)> = Vec::new();
         let mut funcs = BTreeSet::new();
-        let (mut reads_q, mut reads_qd, mut reads_qdd, mut reads_t) = (false, false, false, false);
+        let mut reads = Reads::default();
         let counts = if self.options.naive {
             OpCounts::of_tree(arena, &roots)
         } else {
@@ -320,20 +345,24 @@ impl Context<'_> {
                     (quote!(self.#name), Prec::Atom)
                 }
                 Node::Var(Var::T) => {
-                    reads_t = true;
+                    reads.t = true;
                     (quote!(t), Prec::Atom)
                 }
                 Node::Var(Var::Q(k)) => {
-                    reads_q = true;
+                    reads.q = true;
                     load("q", k)
                 }
                 Node::Var(Var::Qd(k)) => {
-                    reads_qd = true;
+                    reads.qd = true;
                     load("qd", k)
                 }
                 Node::Var(Var::Qdd(k)) => {
-                    reads_qdd = true;
+                    reads.qdd = true;
                     load("qdd", k)
+                }
+                Node::Var(Var::Lambda(i)) => {
+                    reads.lambda = true;
+                    load("lambda", i)
                 }
                 Node::Neg(a) => {
                     let a = operand(a).wrap(Prec::Unary);
@@ -395,14 +424,14 @@ impl Context<'_> {
         };
         loads.sort_by_key(|(v, _)| *v);
         trig_loads.sort_by_key(|(i, _)| *i);
-        let reads_trig = !trig_loads.is_empty();
+        reads.trig = !trig_loads.is_empty();
         let loads = loads
             .into_iter()
             .map(|(_, statement)| statement)
             .chain(trig_loads.into_iter().map(|(_, statement)| statement));
         Function {
             body: quote! { #imports #(#loads)* #(#lets)* #clear #(#writes)* },
-            args: Args::named(reads_q, reads_qd, reads_qdd, reads_trig, reads_t),
+            args: Args::named(reads),
             counts,
         }
     }
@@ -419,6 +448,10 @@ impl Context<'_> {
             Node::Var(Var::Q(k)) => coordinate(k),
             Node::Var(Var::Qd(k)) => format!("{}_dot", coordinate(k)),
             Node::Var(Var::Qdd(k)) => format!("{}_ddot", coordinate(k)),
+            Node::Var(Var::Lambda(i)) => match self.equations.get(i as usize) {
+                Some(name) => format!("lambda_{}", name.replace('.', "_")),
+                None => "lambda_".to_owned(),
+            },
             Node::Call(f, a) => match arena.node(a) {
                 Node::Var(Var::Q(k)) => format!("{}_{}", f.name(), coordinate(k)),
                 _ => f.name().to_owned() + "_",

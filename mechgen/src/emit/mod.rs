@@ -7,6 +7,7 @@
 //! an output with zeros is cleared once and only non-zeros are written.
 
 mod body;
+mod forces;
 mod plan;
 
 use std::cell::RefCell;
@@ -56,7 +57,9 @@ pub fn emit(scene: &Scene) -> TokenStream {
 pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
     let cx = Context {
         model: &scene.model,
+        equations: scene.model.equation_names(),
         kinematics_branches: &scene.kinematics.branches,
+        forces: scene.forces.as_ref(),
         options,
         helpers: RefCell::new(Vec::new()),
     };
@@ -66,6 +69,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
     let mechanism = cx.mechanism_impl(kin);
     let structured = plan::structured_impl(&cx, &scene.plan);
     let accessors = cx.accessors();
+    let force_accessors = cx.forces.map(|_| cx.force_accessors());
     // Split bodies' parts, collected while the functions above were generated.
     let helpers = cx.helpers.into_inner();
     let name = &scene.model.name;
@@ -85,6 +89,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
         #structured
         #helpers
         #accessors
+        #force_accessors
     }
 }
 
@@ -147,6 +152,7 @@ impl Context<'_> {
         let coordinate_units = unit_list(model.coordinate_units());
         let equation_units = unit_list(model.equation_units());
         let branch_names = self.branch_names();
+        let reaction_names = self.forces.map(|_| self.reaction_names());
         let coordinate_doc = format!(
             " Coordinate names in q order ({n} = 3 × {} bodies).",
             model.bodies.len()
@@ -173,6 +179,7 @@ impl Context<'_> {
                 /// Physical dimension of each equation, in Φ order.
                 pub const EQUATION_UNITS: [::mechgen_runtime::Unit; #n_lit] = #equation_units;
                 #branch_names
+                #reaction_names
                 #(#coordinate_consts)*
             }
         }
@@ -202,6 +209,7 @@ impl Context<'_> {
         let check_geometry = self.check_geometry(kin);
         let branch_methods = self.branch_methods(kin);
         let equations = self.textbook_functions(kin);
+        let force_methods = self.forces.map(|forces| self.force_methods(forces));
         let (outputs_variant, markers) = match model.outputs {
             Outputs::Positions => (quote!(Positions), TokenStream::new()),
             Outputs::Velocities => (
@@ -213,6 +221,14 @@ impl Context<'_> {
                 quote! {
                     impl ::mechgen_runtime::Velocities for #name {}
                     impl ::mechgen_runtime::Accelerations for #name {}
+                },
+            ),
+            Outputs::Forces => (
+                quote!(Forces),
+                quote! {
+                    impl ::mechgen_runtime::Velocities for #name {}
+                    impl ::mechgen_runtime::Accelerations for #name {}
+                    impl ::mechgen_runtime::Forces for #name {}
                 },
             ),
         };
@@ -293,6 +309,7 @@ impl Context<'_> {
                 }
 
                 #equations
+                #force_methods
             }
 
             #markers
@@ -411,7 +428,9 @@ impl Context<'_> {
         let (view, what) = match model.outputs {
             Outputs::Positions => (quote!(Pose), "Pose"),
             Outputs::Velocities => (quote!(PoseVelocity), "Pose and velocity"),
-            Outputs::Accelerations => (quote!(BodyState), "Pose, velocity and acceleration"),
+            Outputs::Accelerations | Outputs::Forces => {
+                (quote!(BodyState), "Pose, velocity and acceleration")
+            }
         };
         let declarations = model.bodies.iter().map(|b| {
             let ident = &b.name;

@@ -29,8 +29,13 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
             Stage::Block(block) => kernels.block(cx, s, block, &mut shared),
         }
         kernels.fill_trig(cx, s);
+        if let Some(forces) = cx.forces {
+            kernels.force_stage(cx, s, stage, &forces.stages[s]);
+        }
     }
     let trig_len = idx(plan.trig.len());
+    let n_lit = idx(cx.model.dim());
+    let views = [("trig", &trig_len), ("lambda", &n_lit)];
     let factor_functions = shared.functions(cx);
     let branch = branch_method(cx, plan);
     let vector = quote!(::mechgen_runtime::Vector<Self::Dim>);
@@ -47,7 +52,7 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
             ],
             None,
             true,
-            &trig_len,
+            &views,
         ),
         k.velocities.method(
             "assign_velocities",
@@ -59,7 +64,7 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
             ],
             None,
             false,
-            &trig_len,
+            &views,
         ),
         k.accelerations.method(
             "assign_accelerations",
@@ -72,7 +77,7 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
             ],
             None,
             false,
-            &trig_len,
+            &views,
         ),
         k.jacobian.method(
             "block_jacobian",
@@ -85,14 +90,14 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
             ],
             None,
             true,
-            &trig_len,
+            &views,
         ),
         k.fill_trig.method(
             "fill_trig",
             &[("q", quote!(&#vector)), ("trig", quote!(&mut #slice))],
             None,
             false,
-            &trig_len,
+            &views,
         ),
         k.factor.method(
             "factor",
@@ -103,21 +108,21 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
             ],
             Some(quote!(::core::result::Result<(), usize>)),
             false,
-            &trig_len,
+            &views,
         ),
         k.solve.method(
             "solve",
             &[("values", quote!(&#slice)), ("x", quote!(&mut #slice))],
             None,
             false,
-            &trig_len,
+            &views,
         ),
         k.solve_transpose.method(
             "solve_transpose",
             &[("values", quote!(&#slice)), ("x", quote!(&mut #slice))],
             None,
             false,
-            &trig_len,
+            &views,
         ),
         k.velocity_rhs.method(
             "velocity_rhs",
@@ -130,7 +135,7 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
             ],
             None,
             false,
-            &trig_len,
+            &views,
         ),
         k.acceleration_rhs.method(
             "acceleration_rhs",
@@ -144,7 +149,36 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
             ],
             None,
             false,
-            &trig_len,
+            &views,
+        ),
+        k.multipliers.method(
+            "assign_multipliers",
+            &[
+                ("q", quote!(&#vector)),
+                trig.clone(),
+                ("qd", quote!(&#vector)),
+                ("qdd", quote!(&#vector)),
+                ("lambda", quote!(&mut #slice)),
+                ("t", quote!(f64)),
+            ],
+            None,
+            false,
+            &views,
+        ),
+        k.force_rhs.method(
+            "force_rhs",
+            &[
+                ("q", quote!(&#vector)),
+                trig.clone(),
+                ("qd", quote!(&#vector)),
+                ("qdd", quote!(&#vector)),
+                ("lambda", quote!(&#slice)),
+                ("t", quote!(f64)),
+                ("out", quote!(&mut #slice)),
+            ],
+            None,
+            false,
+            &views,
         ),
     ];
     let functions = &kernels.functions;
@@ -155,6 +189,12 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
         idx(cx.model.dim()),
     );
     let stage_count = idx(plan.stages.len());
+    // The force solve's storage: the multipliers, then every block's archived factors.
+    let forces = cx.forces.map(|_| {
+        let archive: usize = plan.blocks().map(Block::slots).sum();
+        let r = idx(cx.model.dim() + archive);
+        quote!(, #r)
+    });
     quote! {
         impl #name {
             #table
@@ -163,7 +203,7 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
         }
 
         impl ::mechgen_runtime::Structured for #name {
-            type Workspace = ::mechgen_runtime::Buffers<#b, #s, #k, #n, #trig_len>;
+            type Workspace = ::mechgen_runtime::Buffers<#b, #s, #k, #n, #trig_len #forces>;
 
             fn workspace(&self) -> Self::Workspace {
                 ::mechgen_runtime::Buffers::new()
@@ -249,14 +289,14 @@ fn branch_method(cx: &Context<'_>, plan: &Plan) -> TokenStream {
 
 /// A trait method's arms (stage, statements), and the parameters they read.
 #[derive(Default)]
-struct Dispatch {
+pub(super) struct Dispatch {
     arms: Vec<(usize, TokenStream)>,
     reads: BTreeSet<&'static str>,
 }
 
 impl Dispatch {
     /// The statements for stage `s`, calling a kernel with `arguments` (by name).
-    fn push(&mut self, s: usize, statements: TokenStream, arguments: &[&'static str]) {
+    pub(super) fn push(&mut self, s: usize, statements: TokenStream, arguments: &[&'static str]) {
         self.arms.push((s, statements));
         self.reads.insert("stage");
         self.reads.extend(arguments);
@@ -266,15 +306,16 @@ impl Dispatch {
     /// (`required` methods are written anyway, reading nothing). Parameters no arm reads get a
     /// leading underscore.
     ///
-    /// The kernels take the trig cache as an array of `trig_len` values: when one reads it, the
-    /// method views the runtime's slice as that array first.
+    /// The kernels take the trig cache (`trig`) and the multipliers (`lambda`) as arrays of
+    /// the lengths in `views`: when one reads such a parameter, the method views the
+    /// runtime's slice as that array first.
     fn method(
         &self,
         name: &str,
         params: &[(&'static str, TokenStream)],
         result: Option<TokenStream>,
         required: bool,
-        trig_len: &Literal,
+        views: &[(&str, &Literal)],
     ) -> TokenStream {
         if self.arms.is_empty() && !required {
             return TokenStream::new();
@@ -287,9 +328,29 @@ impl Dispatch {
             }
         };
         let stage = named("stage");
-        let writes_trig = params
+        let early = if result.is_some() {
+            quote!(return ::core::result::Result::Err(0))
+        } else {
+            quote!(return)
+        };
+        let conversions: Vec<TokenStream> = views
             .iter()
-            .any(|(p, ty)| *p == "trig" && ty.to_string().contains("mut"));
+            .filter(|(view, _)| self.reads.contains(view))
+            .filter_map(|(view, len)| {
+                let (_, ty) = params.iter().find(|(p, _)| p == view)?;
+                let chunk = if ty.to_string().contains("mut") {
+                    quote!(first_chunk_mut)
+                } else {
+                    quote!(first_chunk)
+                };
+                let view = format_ident!("{}", view);
+                Some(quote! {
+                    let ::core::option::Option::Some(#view) = #view.#chunk::<#len>() else {
+                        #early;
+                    };
+                })
+            })
+            .collect();
         let params = params.iter().map(|(param, ty)| {
             let param = named(param);
             quote!(#param: #ty)
@@ -299,30 +360,13 @@ impl Dispatch {
         let fallback = result
             .is_some()
             .then(|| quote!(::core::result::Result::Err(0)));
-        let trig = self.reads.contains("trig").then(|| {
-            let view = if writes_trig {
-                quote!(first_chunk_mut)
-            } else {
-                quote!(first_chunk)
-            };
-            let early = if result.is_some() {
-                quote!(return ::core::result::Result::Err(0))
-            } else {
-                quote!(return)
-            };
-            quote! {
-                let ::core::option::Option::Some(trig) = trig.#view::<#trig_len>() else {
-                    #early;
-                };
-            }
-        });
         let body = match &self.arms[..] {
             [] => quote!(#fallback),
             // One stage: `if`, not a one-arm `match` (clippy's `single_match` in included code).
             [(s, statements)] => {
                 let s = idx(*s);
                 let otherwise = fallback.as_ref().map(|f| quote!(else { #f }));
-                quote! { #trig if #stage == #s { #statements } #otherwise }
+                quote! { #(#conversions)* if #stage == #s { #statements } #otherwise }
             }
             arms => {
                 let arms = arms.iter().map(|(s, statements)| {
@@ -330,7 +374,7 @@ impl Dispatch {
                     quote! { #s => { #statements } }
                 });
                 let fallback = fallback.unwrap_or_else(|| quote!({}));
-                quote! { #trig match #stage { #(#arms)* _ => #fallback } }
+                quote! { #(#conversions)* match #stage { #(#arms)* _ => #fallback } }
             }
         };
         quote! {
@@ -470,7 +514,7 @@ fn stage_lines(stage: &Stage, coordinates: &[String], equations: &[String]) -> V
 type Level = (&'static str, Option<Vec<Id>>, &'static [&'static str]);
 
 /// The per-stage functions and the trait methods' dispatch.
-struct Kernels<'p> {
+pub(super) struct Kernels<'p> {
     trig: &'p TrigCache,
     functions: Vec<TokenStream>,
     fill_trig: Dispatch,
@@ -483,18 +527,20 @@ struct Kernels<'p> {
     solve_transpose: Dispatch,
     velocity_rhs: Dispatch,
     acceleration_rhs: Dispatch,
+    /// The force solve's (`emit/forces.rs`).
+    pub(super) multipliers: Dispatch,
+    pub(super) force_rhs: Dispatch,
 }
 
 /// A generated kernel: its function, and the inputs its caller passes (by name, in order).
-struct Kernel {
+pub(super) struct Kernel {
     function: Ident,
-    arguments: Vec<&'static str>,
+    pub(super) arguments: Vec<&'static str>,
 }
 
 impl Kernel {
-    /// `self.function(arguments…)`, the arguments converted by `convert` (array views of the
-    /// runtime's slices).
-    fn call(&self) -> TokenStream {
+    /// `self.function(arguments…)`.
+    pub(super) fn call(&self) -> TokenStream {
         let function = &self.function;
         let arguments = self.arguments.iter().map(|a| format_ident!("{}", a));
         quote!(self.#function(#(#arguments),*))
@@ -503,7 +549,7 @@ impl Kernel {
 
 /// The `'static` name of a kernel input.
 fn static_name(input: &str) -> &'static str {
-    ["q", "qd", "qdd", "trig", "t"]
+    ["q", "qd", "qdd", "lambda", "trig", "t"]
         .into_iter()
         .find(|&n| n == input)
         .unwrap_or("q")
@@ -524,6 +570,8 @@ impl<'p> Kernels<'p> {
             solve_transpose: Dispatch::default(),
             velocity_rhs: Dispatch::default(),
             acceleration_rhs: Dispatch::default(),
+            multipliers: Dispatch::default(),
+            force_rhs: Dispatch::default(),
         }
     }
 
@@ -557,10 +605,10 @@ impl<'p> Kernels<'p> {
         self.fill_trig.push(s, quote!(#call;), &kernel.arguments);
     }
 
-    /// A kernel writing `outputs`: it takes the `inputs` (`q`, `qd`, `qdd`, `t`) its body reads,
-    /// then the outputs `outs`.
+    /// A kernel writing `outputs`: it takes the `inputs` (`q`, `qd`, `qdd`, `lambda`, `t`) its
+    /// body reads, then the outputs `outs`.
     #[allow(clippy::too_many_arguments)]
-    fn kernel(
+    pub(super) fn kernel(
         &mut self,
         cx: &Context<'_>,
         s: usize,
@@ -576,12 +624,14 @@ impl<'p> Kernels<'p> {
         let cached = self.trig.reads(cx.arena(), &roots, s, phase);
         let vector = cx.vector_type();
         let trig_len = idx(self.trig.len());
+        let n = idx(cx.model.dim());
         let typed: Vec<(&str, TokenStream)> = inputs
             .iter()
             .chain(&["trig"])
             .map(|&input| {
                 let ty = match input {
                     "trig" => quote!(&[f64; #trig_len]),
+                    "lambda" => quote!(&[f64; #n]),
                     _ => quote!(&#vector),
                 };
                 (input, ty)

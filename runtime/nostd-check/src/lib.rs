@@ -8,19 +8,25 @@ use mechgen_runtime::{Simulation, Solver, mechanism, write_csv_header};
 
 // Generated code, not a hand-written mechanism: this proves that what `mechanism!` emits (math
 // shim, fixed-size storage, no std paths) links without std or alloc. The scene uses every joint
-// kind, a time-varying driver and a branch invariant so every emission path is exercised.
+// kind, a time-varying driver, a branch invariant, and mass properties, gravity and every load
+// kind (so the force solve is generated and run), so every emission path is exercised.
 mechanism! {
     /// A slider-crank whose connecting rod is a distance link, driven by an oscillating crank.
     mechanism Linkage {
         param amplitude = 0.5;
         ground frame at (0, 0, 0);
-        body crank near (0, 0, 0);
-        body slider near (3.4, 0, 0);
+        body crank near (0, 0, 0) mass 2 inertia 0.1 centre (0.3, 0);
+        body slider near (3.4, 0, 0) mass 1 inertia 0.05;
         joint pivot: revolute(frame, crank);
         joint guide: prismatic(frame, slider, along (1, 0));
         joint rod: distance(crank @ (1, 0), slider, 2.5);
         driver swing: angle(crank) = amplitude * sin(3 * t) + t^2 / 10;
         branch slider_ahead: dot(frame -> frame @ (1, 0), crank @ (1, 0) -> slider) > 0;
+        gravity (0, -9.81);
+        load gas: force(slider) = (-3 * sin(t), 0);
+        load nudge: local_force(crank @ (1, 0)) = (0, 0.5);
+        load brake: torque(crank) = -0.1 * t;
+        load coil: spring(frame @ (5, 0), slider, stiffness 10, length 1.5, damping 0.2);
     }
 }
 
@@ -46,6 +52,7 @@ pub extern "C" fn mechgen_nostd_check(t_end: f64, steps: u32) -> usize {
     let mut ok = true;
     let run = simulation.run(t_end, steps as usize, |state| {
         ok &= state.write_csv_row(&mut sink).is_ok();
+        ok &= state.constraint_forces().iter().all(|f| f.is_finite());
     });
     match run {
         Ok(()) if ok => sink.0,

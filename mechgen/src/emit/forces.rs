@@ -1,0 +1,297 @@
+//! The force solve as code, for a scene that computes forces: the textbook functions
+//! (`generalized_forces`, `reactions`, `reaction_name` in `impl Mechanism`), the `REACTIONS`
+//! names, each stage's reverse-sweep kernel (`stage_k_multipliers` for explicit stages,
+//! `stage_k_force_rhs` for blocks, dispatched by `assign_multipliers` and `force_rhs`), and the
+//! named accessors `state.reactions()` and `state.efforts()`.
+//!
+//! A scene without the `forces` output gets none of this: its code is exactly what it was.
+
+use proc_macro2::TokenStream;
+use quote::{format_ident, quote};
+
+use super::body::{Context, computed};
+use super::plan::Kernels;
+use super::{idx, signature_with};
+use crate::expr::Id;
+use crate::model::ConstraintKind;
+use crate::reactions::{ForceStage, Forces};
+use crate::structure::{Phase, Stage};
+
+impl Context<'_> {
+    /// `generalized_forces`, `reactions` and `reaction_name` for `impl Mechanism`.
+    pub(super) fn force_methods(&self, forces: &Forces) -> TokenStream {
+        let vector = self.vector_type();
+        let n = idx(self.model.dim());
+        let generalized = {
+            let outputs = super::vector_outputs(&forces.generalized, &quote!(out));
+            let clear = super::clear_if_sparse(self.arena(), &forces.generalized, &quote!(out));
+            let inputs = [
+                ("q", quote!(&#vector)),
+                ("qd", quote!(&#vector)),
+                ("qdd", quote!(&#vector)),
+            ];
+            let outs = [("out", quote!(&mut #vector))];
+            let f = self.bounded(
+                "generalized_forces",
+                &outputs,
+                clear,
+                &outs,
+                &inputs,
+                &computed(),
+            );
+            let (qd, qdd) = (&f.args.qd, &f.args.qdd);
+            signature_with(
+                &f,
+                "F(q, q̇, q̈, t) = Q − M q̈ (gravity, loads, springs and inertia per coordinate)",
+                quote!(generalized_forces),
+                quote!(#qd: &#vector, #qdd: &#vector,),
+                quote!(out: &mut #vector),
+            )
+        };
+        let reactions = {
+            let outputs = super::vector_outputs(&forces.reactions, &quote!(out));
+            let clear = super::clear_if_sparse(self.arena(), &forces.reactions, &quote!(out));
+            let f = self.function(&outputs, clear, &computed());
+            let (doc, body) = (f.doc("the reported reactions from λ"), f.body);
+            let (q, qd, lambda) = (&f.args.q, &f.args.qd, &f.args.lambda);
+            quote! {
+                #doc
+                fn reactions(
+                    &self,
+                    #q: &#vector,
+                    #qd: &#vector,
+                    #lambda: &[f64],
+                    out: &mut #vector,
+                ) {
+                    let ::core::option::Option::Some(#lambda) = #lambda.first_chunk::<#n>() else {
+                        out.as_mut_slice().fill(f64::NAN);
+                        return;
+                    };
+                    #body
+                }
+            }
+        };
+        quote! {
+            #generalized
+            #reactions
+            fn reaction_name(&self, index: usize) -> ::core::option::Option<&str> {
+                Self::REACTIONS.get(index).copied()
+            }
+        }
+    }
+
+    /// The `REACTIONS` names.
+    pub(super) fn reaction_names(&self) -> TokenStream {
+        let names = self.model.reaction_names();
+        let n = idx(names.len());
+        quote! {
+            /// The reaction each equation reports, in Φ order (`state.constraint_forces()`, the
+            /// CSV's force columns).
+            pub const REACTIONS: [&'static str; #n] = [#(#names),*];
+        }
+    }
+
+    /// `XReactions` (a field per joint and ground body), `XEfforts` (a field per driver) and
+    /// the trait `XForces` giving them from a solved state.
+    pub(super) fn force_accessors(&self) -> TokenStream {
+        let model = self.model;
+        let (vis, name) = (&model.vis, &model.name);
+        let reactions_type = format_ident!("{}Reactions", name);
+        let efforts_type = format_ident!("{}Efforts", name);
+        let forces_trait = format_ident!("{}Forces", name);
+        let runtime = quote!(::mechgen_runtime);
+        let (mut reaction_fields, mut reaction_values) = (Vec::new(), Vec::new());
+        let (mut effort_fields, mut effort_values) = (Vec::new(), Vec::new());
+        let mut row = 0;
+        for constraint in &model.constraints {
+            let field = format_ident!("{}", constraint.name);
+            let at = |k: usize| idx(row + k);
+            let (doc, ty, value) = match constraint.kind {
+                ConstraintKind::Ground { .. } => {
+                    let [x, y, z] = [at(0), at(1), at(2)];
+                    (
+                        format!(
+                            " Ground body `{}`: the force (world axes) and torque (about its \
+                             reference point) the mechanism exerts on it.",
+                            constraint.name
+                        ),
+                        quote!(#runtime::GroundLoad),
+                        quote!(#runtime::GroundLoad { fx: r[#x], fy: r[#y], torque: r[#z] }),
+                    )
+                }
+                ConstraintKind::Revolute { a, b } => {
+                    let [x, y] = [at(0), at(1)];
+                    (
+                        format!(
+                            " Revolute joint `{}`: the force (world axes) `{}` exerts on `{}`.",
+                            constraint.name,
+                            self.body_name(b.body),
+                            self.body_name(a.body)
+                        ),
+                        quote!(#runtime::RevoluteReaction),
+                        quote!(#runtime::RevoluteReaction { fx: r[#x], fy: r[#y] }),
+                    )
+                }
+                ConstraintKind::Prismatic { a, b, .. } => {
+                    let [normal, torque] = [at(0), at(1)];
+                    (
+                        format!(
+                            " Prismatic joint `{}`: the normal force and torque `{}` exerts on \
+                             `{}`.",
+                            constraint.name,
+                            self.body_name(b.body),
+                            self.body_name(a.body)
+                        ),
+                        quote!(#runtime::PrismaticReaction),
+                        quote!(#runtime::PrismaticReaction { normal: r[#normal], torque: r[#torque] }),
+                    )
+                }
+                ConstraintKind::Distance { .. } => {
+                    let tension = at(0);
+                    (
+                        format!(" Distance joint `{}`: its tension.", constraint.name),
+                        quote!(#runtime::DistanceReaction),
+                        quote!(#runtime::DistanceReaction { tension: r[#tension] }),
+                    )
+                }
+                ConstraintKind::Driver { .. } => {
+                    let effort = at(0);
+                    let doc = format!(
+                        " Driver `{}`: the generalised force it applies along its coordinate \
+                         (a torque for angles, a force for positions and travel).",
+                        constraint.name
+                    );
+                    effort_fields.push(quote! { #[doc = #doc] pub #field: f64, });
+                    effort_values.push(quote! { #field: r[#effort], });
+                    row += 1;
+                    continue;
+                }
+            };
+            reaction_fields.push(quote! { #[doc = #doc] pub #field: #ty, });
+            reaction_values.push(quote! { #field: #value, });
+            row += constraint.kind.equation_suffixes().len();
+        }
+        let reactions_doc = format!(
+            " The reactions of a solved [`{name}`] state: a field per joint and ground body, in \
+             the scene's units."
+        );
+        let efforts_doc = format!(
+            " The driver efforts of a solved [`{name}`] state: a field per driver, in the \
+             scene's units."
+        );
+        let trait_doc = format!(
+            " Named access to the forces of a solved [`{name}`] state: `state.reactions()`, \
+             `state.efforts()`."
+        );
+        quote! {
+            #[doc = #reactions_doc]
+            #[derive(Debug, Clone, Copy, PartialEq)]
+            #vis struct #reactions_type {
+                #(#reaction_fields)*
+            }
+
+            #[doc = #efforts_doc]
+            #[derive(Debug, Clone, Copy, PartialEq)]
+            #vis struct #efforts_type {
+                #(#effort_fields)*
+            }
+
+            #[doc = #trait_doc]
+            #vis trait #forces_trait {
+                /// The reaction of every joint and the load on every ground body.
+                fn reactions(&self) -> #reactions_type;
+                /// The effort of every driver.
+                fn efforts(&self) -> #efforts_type;
+            }
+
+            impl #forces_trait for #runtime::State<#name> {
+                fn reactions(&self) -> #reactions_type {
+                    let r = self.constraint_forces();
+                    #reactions_type { #(#reaction_values)* }
+                }
+
+                fn efforts(&self) -> #efforts_type {
+                    let r = self.constraint_forces();
+                    #efforts_type { #(#effort_values)* }
+                }
+            }
+        }
+    }
+
+    fn body_name(&self, body: usize) -> String {
+        self.model
+            .bodies
+            .get(body)
+            .map_or_else(String::new, |b| b.name.to_string())
+    }
+}
+
+impl Kernels<'_> {
+    /// Stage `s`'s kernel of the force solve: an explicit stage's multipliers, or a block's
+    /// force right-hand side. Both run after the whole forward sweep (every trig slot filled).
+    pub(super) fn force_stage(
+        &mut self,
+        cx: &Context<'_>,
+        s: usize,
+        stage: &Stage,
+        force: &ForceStage,
+    ) {
+        let n = idx(cx.model.dim());
+        let some = quote!(::core::option::Option::Some);
+        match (stage, force) {
+            (Stage::Explicit(assignments), ForceStage::Explicit(values)) => {
+                let outputs: Vec<(TokenStream, Id)> = assignments
+                    .iter()
+                    .zip(values)
+                    .map(|(a, &v)| {
+                        let e = idx(a.equation);
+                        (quote!(lambda[#e]), v)
+                    })
+                    .collect();
+                let kernel = self.kernel(
+                    cx,
+                    s,
+                    Phase::Final,
+                    "assigns its equations' multipliers (force solve)",
+                    &format!("stage_{s}_multipliers"),
+                    &outputs,
+                    &["q", "qd", "qdd", "lambda"],
+                    &[("lambda", quote!(&mut [f64; #n]))],
+                );
+                let call = kernel.call();
+                self.multipliers.push(s, quote!(#call;), &kernel.arguments);
+            }
+            (Stage::Block(block), ForceStage::Block(values)) => {
+                let len = idx(block.equations.len());
+                let outputs: Vec<(TokenStream, Id)> = values
+                    .iter()
+                    .enumerate()
+                    .map(|(j, &v)| {
+                        let j = idx(j);
+                        (quote!(out[#j]), v)
+                    })
+                    .collect();
+                let kernel = self.kernel(
+                    cx,
+                    s,
+                    Phase::Final,
+                    "the block's force right-hand side",
+                    &format!("stage_{s}_force_rhs"),
+                    &outputs,
+                    &["q", "qd", "qdd", "lambda"],
+                    &[("out", quote!(&mut [f64; #len]))],
+                );
+                let call = kernel.call();
+                let arm = quote! {
+                    let #some(out) = out.first_chunk_mut::<#len>() else {
+                        return;
+                    };
+                    #call;
+                };
+                self.force_rhs.push(s, arm, &kernel.arguments);
+            }
+            // The force plan follows the kinematic plan stage for stage.
+            _ => {}
+        }
+    }
+}

@@ -1,0 +1,322 @@
+//! The force solve's structure: `Φ_qᵀ λ = F` along the kinematic plan, in reverse, and the
+//! reactions reported from the multipliers λ.
+//!
+//! The plan orders Φ_q block lower triangular: a stage's equations read only its own and
+//! earlier coordinates. So a stage's coordinates are touched only by its own equations and by
+//! later stages', and in reverse stage order each stage's multipliers follow from what the
+//! later ones left of the generalised force on its coordinates:
+//!
+//! - an explicit assignment (equation e assigns coordinate c with constant coefficient a) gives
+//!   `λ_e = (F_c − Σ_{i ≠ e} Φ_q[i, c] λ_i) / a` in closed form; assignments of one stage that
+//!   read each other are resolved in dependency order, so each expression reads only later
+//!   stages' multipliers;
+//! - a block's right-hand side is `r_c = F_c − Σ_{i later} Φ_q[i, c] λ_i` per coordinate, and
+//!   the runtime solves `Φ_q[b, b]ᵀ λ_b = r` with the block's static LU.
+//!
+//! Fixed coordinates and constant rates are substituted, so the frame, a driven crank's
+//! constant speed and the like cost nothing. The reported reaction of each equation is then a
+//! simple function of λ: a revolute joint's force on its first body is `−λ`, a prismatic
+//! joint's normal force and torque `λ`, a distance joint's tension `2 L λ`, a driver's effort
+//! `−λ`, and a ground body's load is what the textbook formulation's multiplier would be,
+//! `−Σ_i ∂Φ_i/∂q_ground λ_i` (the joints seen through the frame's coordinates), plus the pull
+//! of the springs anchored to it.
+
+use std::collections::HashMap;
+
+use crate::diff::Differentiator;
+use crate::expr::{Arena, Id, Var};
+use crate::kinematics::Kinematics;
+use crate::model::{ConstraintKind, Model};
+use crate::structure::{Plan, Stage};
+
+/// A scene's force solve: the generalised forces, the reverse stages and the reported
+/// reactions (ids into the model's arena).
+#[derive(Debug, Clone)]
+pub struct Forces {
+    /// `F(q, q̇, q̈, t)` per coordinate (`dynamics`), unsubstituted: the textbook
+    /// `generalized_forces` and the dense reference's right-hand side.
+    pub generalized: Vec<Id>,
+    /// Per stage of the plan, at the same index (the runtime walks them in reverse).
+    pub stages: Vec<ForceStage>,
+    /// Per equation, its reported reaction, in the multipliers (`Var::Lambda`), q, q̇ (a
+    /// damper's pull on the frame) and the parameters.
+    pub reactions: Vec<Id>,
+}
+
+/// What the force solve computes for one stage.
+#[derive(Debug, Clone)]
+pub enum ForceStage {
+    /// The multiplier of each assignment's equation, in the stage's assignment order, reading
+    /// only later stages' multipliers.
+    Explicit(Vec<Id>),
+    /// The block's force right-hand side, in its local column order.
+    Block(Vec<Id>),
+}
+
+impl Forces {
+    /// The non-zero outputs of the textbook force functions, by name (for operation counts).
+    pub fn function_outputs(&self, arena: &Arena) -> Vec<(&'static str, Vec<Id>)> {
+        let nonzero = |ids: &[Id]| -> Vec<Id> {
+            ids.iter().copied().filter(|&i| !arena.is_zero(i)).collect()
+        };
+        vec![
+            ("generalized_forces", nonzero(&self.generalized)),
+            ("reactions", nonzero(&self.reactions)),
+        ]
+    }
+}
+
+/// Plans the force solve of a scene whose generalised forces are `generalized`, adding its
+/// expressions to the model's arena.
+pub fn plan(model: &mut Model, kin: &Kinematics, plan: &Plan, generalized: Vec<Id>) -> Forces {
+    let reactions = reported(model, kin);
+    let n = kin.phi.len();
+    let mut columns: Vec<Vec<(usize, Id)>> = vec![Vec::new(); n];
+    for e in &kin.jacobian {
+        columns[e.col].push((e.row, e.value));
+    }
+    let known = known_values(&model.arena, plan);
+    let mut cx = Transpose {
+        arena: &mut model.arena,
+        known,
+        memo: HashMap::new(),
+        columns,
+        generalized: &generalized,
+    };
+    let stages = plan
+        .stages
+        .iter()
+        .map(|stage| match stage {
+            Stage::Explicit(assignments) => {
+                let pairs: Vec<(usize, usize)> = assignments
+                    .iter()
+                    .map(|a| (a.equation, a.coordinate))
+                    .collect();
+                ForceStage::Explicit(cx.explicit(&pairs))
+            }
+            Stage::Block(block) => ForceStage::Block(
+                block
+                    .coordinates
+                    .iter()
+                    .map(|&c| cx.remainder(c, &block.equations))
+                    .collect(),
+            ),
+        })
+        .collect();
+    Forces {
+        generalized,
+        stages,
+        reactions,
+    }
+}
+
+/// What the plan knows to be constant: fixed positions, and rates that turned out constant
+/// (the same substitutions the plan made in its own expressions).
+fn known_values(arena: &Arena, plan: &Plan) -> HashMap<Var, Id> {
+    let mut known = HashMap::new();
+    for a in plan.assignments() {
+        let c = index(a.coordinate);
+        let values = [
+            (Var::Q(c), Some(a.position)),
+            (Var::Qd(c), a.velocity),
+            (Var::Qdd(c), a.acceleration),
+        ];
+        for (var, value) in values {
+            if let Some(value) = value.filter(|&v| arena.is_invariant(v)) {
+                known.insert(var, value);
+            }
+        }
+    }
+    known
+}
+
+/// The reverse sweep's expressions, built over one arena.
+struct Transpose<'a> {
+    arena: &'a mut Arena,
+    /// Constant positions and rates, substituted everywhere.
+    known: HashMap<Var, Id>,
+    memo: HashMap<Id, Id>,
+    /// Each coordinate's Jacobian column: (equation, ∂Φ/∂q) pairs.
+    columns: Vec<Vec<(usize, Id)>>,
+    generalized: &'a [Id],
+}
+
+impl Transpose<'_> {
+    /// `e` with the known values substituted.
+    fn known(&mut self, e: Id) -> Id {
+        self.arena.substitute(e, &self.known, &mut self.memo)
+    }
+
+    /// `F_c − Σ Φ_q[i, c] λ_i` over the equations touching coordinate `c` except `own`.
+    fn remainder(&mut self, c: usize, own: &[usize]) -> Id {
+        let mut rest = self.known(self.generalized[c]);
+        for (i, value) in self.columns[c].clone() {
+            if own.contains(&i) {
+                continue;
+            }
+            let value = self.known(value);
+            let lambda = self.arena.var(Var::Lambda(index(i)));
+            let term = self.arena.mul(value, lambda);
+            rest = self.arena.sub(rest, term);
+        }
+        rest
+    }
+
+    /// The multipliers of an explicit stage's (equation, coordinate) assignments, each divided
+    /// by its coefficient and with the stage's own multipliers substituted in dependency order.
+    fn explicit(&mut self, assignments: &[(usize, usize)]) -> Vec<Id> {
+        let raw: Vec<Id> = assignments
+            .iter()
+            .map(|&(e, c)| {
+                let rest = self.remainder(c, &[e]);
+                let coefficient = self.columns[c]
+                    .iter()
+                    .find(|(i, _)| *i == e)
+                    .map_or(self.arena.one(), |&(_, v)| v);
+                let coefficient = self.known(coefficient);
+                divide(self.arena, rest, coefficient)
+            })
+            .collect();
+        let own: HashMap<Var, usize> = assignments
+            .iter()
+            .enumerate()
+            .map(|(k, &(e, _))| (Var::Lambda(index(e)), k))
+            .collect();
+        // An assignment's multiplier reads the multipliers of the stage's assignments that
+        // were solved after it (those touch its coordinate); resolve those first. The plan
+        // solved them one after another, so there is always one left that reads no unresolved
+        // one.
+        let mut resolved: HashMap<Var, Id> = HashMap::new();
+        let mut values: Vec<Option<Id>> = vec![None; raw.len()];
+        while values.iter().any(Option::is_none) {
+            let mut progress = false;
+            for k in 0..raw.len() {
+                if values[k].is_some() {
+                    continue;
+                }
+                let ready = self
+                    .arena
+                    .variables(raw[k])
+                    .iter()
+                    .all(|v| !own.contains_key(v) || resolved.contains_key(v));
+                if ready {
+                    let value = self
+                        .arena
+                        .substitute(raw[k], &resolved, &mut HashMap::new());
+                    resolved.insert(Var::Lambda(index(assignments[k].0)), value);
+                    values[k] = Some(value);
+                    progress = true;
+                }
+            }
+            if !progress {
+                break;
+            }
+        }
+        values
+            .into_iter()
+            .zip(raw)
+            .map(|(value, raw)| value.unwrap_or(raw))
+            .collect()
+    }
+}
+
+/// `e / a`, exactly `e` or `−e` for a coefficient of ±1.
+fn divide(arena: &mut Arena, e: Id, a: Id) -> Id {
+    match arena.as_const(a) {
+        Some(1.0) => e,
+        Some(-1.0) => arena.neg(e),
+        _ => arena.div(e, a),
+    }
+}
+
+/// The reported reaction of every equation, from its multiplier (and, for a ground body's
+/// load, the multipliers of the joints that touch it).
+fn reported(model: &mut Model, kin: &Kinematics) -> Vec<Id> {
+    let kinds: Vec<ConstraintKind> = model.constraints.iter().map(|c| c.kind).collect();
+    let loads = ground_loads(model, kin.phi.len());
+    let arena = &mut model.arena;
+    let mut reactions = Vec::with_capacity(kin.phi.len());
+    for kind in kinds {
+        let first = reactions.len();
+        let lambda = |arena: &mut Arena, k: usize| arena.var(Var::Lambda(index(first + k)));
+        match kind {
+            ConstraintKind::Ground { body, .. } => {
+                reactions.extend((0..3).map(|k| loads[3 * body + k]));
+            }
+            ConstraintKind::Revolute { .. } | ConstraintKind::Driver { .. } => {
+                for k in 0..kind.equation_suffixes().len() {
+                    let l = lambda(arena, k);
+                    reactions.push(arena.neg(l));
+                }
+            }
+            ConstraintKind::Prismatic { .. } => {
+                reactions.extend((0..2).map(|k| lambda(arena, k)));
+            }
+            ConstraintKind::Distance { length, .. } => {
+                // Φ = |d|² − L²: the force on the first body is 2 λ d, along d with length L.
+                let l = lambda(arena, 0);
+                let two = arena.constant(2.0);
+                let twice = arena.mul(two, length);
+                reactions.push(arena.mul(twice, l));
+            }
+        }
+    }
+    reactions
+}
+
+/// The load on each ground body's coordinates (zero for moving ones): with the joints written
+/// through the frame's coordinates, `−Σ_i ∂Φ_i/∂q_k λ_i` at the frame's pose, plus the pull of
+/// the springs anchored to it.
+fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
+    let mut loads = crate::dynamics::ground_spring_loads(model);
+    debug_assert_eq!(loads.len(), n);
+    let ground: Vec<(usize, [Id; 3])> = model
+        .bodies
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| b.ground)
+        .map(|(i, b)| (i, b.pose))
+        .collect();
+    if ground.is_empty() {
+        return loads;
+    }
+    let textbook = crate::kinematics::textbook_equations(model);
+    // Ground equations touch only their own body, and their multipliers are not loads.
+    let ground_rows: Vec<bool> = model
+        .constraints
+        .iter()
+        .flat_map(|c| {
+            let ground = matches!(c.kind, ConstraintKind::Ground { .. });
+            std::iter::repeat_n(ground, c.kind.equation_suffixes().len())
+        })
+        .collect();
+    let arena = &mut model.arena;
+    let pose: HashMap<Var, Id> = ground
+        .iter()
+        .flat_map(|&(body, pose)| (0..3).map(move |k| (Var::Q(index(3 * body + k)), pose[k])))
+        .collect();
+    let mut memo = HashMap::new();
+    let mut d = Differentiator::new();
+    for (i, &phi) in textbook.iter().enumerate() {
+        if ground_rows[i] {
+            continue;
+        }
+        for var in arena.variables(phi) {
+            let Var::Q(k) = var else { continue };
+            let k = k as usize;
+            if !pose.contains_key(&var) {
+                continue;
+            }
+            let partial = d.diff(arena, phi, var);
+            let partial = arena.substitute(partial, &pose, &mut memo);
+            let lambda = arena.var(Var::Lambda(index(i)));
+            let term = arena.mul(partial, lambda);
+            loads[k] = arena.sub(loads[k], term);
+        }
+    }
+    loads
+}
+
+fn index(k: usize) -> u32 {
+    u32::try_from(k).unwrap_or(u32::MAX)
+}

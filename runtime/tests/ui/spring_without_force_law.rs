@@ -1,0 +1,14 @@
+//! A spring with neither stiffness nor damping; the error points at `spring`.
+use mechgen_runtime::mechanism;
+
+mechanism! {
+    mechanism Arm {
+        ground frame at (0, 0, 0);
+        body arm near (1, 0, 0) mass 1;
+        joint pivot: revolute(frame, arm);
+        driver spin: angle(arm) = t;
+        load coil: spring(frame @ (0, 2), arm);
+    }
+}
+
+fn main() {}
