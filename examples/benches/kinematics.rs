@@ -18,7 +18,10 @@
 //! Φ_q and Φ+Φ_q at an assembled state, which the report prints beside its own figures.
 //!
 //! The group `seed/safeguards` times a seed step with the stability safeguards (unit scaling,
-//! condition estimate) on and off.
+//! condition estimate) on and off. The groups `seed_forces/*` time the seed with its mass
+//! properties, whose step adds the force solve (reactions and driving torque), against the
+//! closed form plus its Newton–Euler elimination (`mechgen_examples::inverse_dynamics`) and
+//! against the kinematic seed step of the same run.
 //!
 //! After criterion's figures, the run prints each scene's fastest batch per step for
 //! `closed_form`, `generated` and `dense`, and their ratios: fastest batches, because the
@@ -33,8 +36,9 @@ use std::time::{Duration, Instant};
 use criterion::{BenchmarkGroup, Criterion, measurement::WallTime};
 use mechgen_cli::Interpreted;
 use mechgen_examples::closed_form;
+use mechgen_examples::inverse_dynamics::{MassProperties, seed_reactions};
 use mechgen_examples::report::{AutoDiff, CentralDifference, ForwardDifference, Plan};
-use mechgen_examples::scenes::{FourBar, OffsetSlider, PistonCrank};
+use mechgen_examples::scenes::{FourBar, OffsetSlider, PistonCrank, PistonCrankDynamics};
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{
     Dense, Matrix, Mechanism, Simulation, Solver, SolverOptions, State, Storage, Structured, Vector,
@@ -295,6 +299,34 @@ fn seed(c: &mut Criterion, fastest: &Fastest) {
     );
 }
 
+/// The seed with masses: a step with the force solve, generated, through the dense reference
+/// and interpreted, against the closed form with its inverse dynamics.
+fn seed_forces(c: &mut Criterion, fastest: &Fastest) {
+    let seed = PistonCrankDynamics::default();
+    let period = 2.0 * std::f64::consts::PI / seed.omega;
+    let (form, mass) = (
+        closed_form::PistonCrank::default(),
+        MassProperties::default(),
+    );
+    closed(
+        c,
+        fastest,
+        "seed_forces/closed_form",
+        (form, mass),
+        period / STEPS as f64,
+        |(form, mass), t| seed_reactions(form, mass, &form.kinematics(t)),
+    );
+    driven(c, fastest, "seed_forces/generated", seed, period);
+    driven(c, fastest, "seed_forces/dense", Dense::new(seed), period);
+    driven(
+        c,
+        fastest,
+        "seed_forces/interpreted",
+        interpreted("piston_crank_dynamics.mech"),
+        period,
+    );
+}
+
 fn four_bar(c: &mut Criterion, fastest: &Fastest) {
     let four_bar = FourBar::default();
     let period = 2.0 * std::f64::consts::PI / four_bar.omega;
@@ -362,6 +394,7 @@ fn summary(fastest: &Fastest) {
     );
     for (scene, what) in [
         ("seed", "seed (q, q̇, q̈)"),
+        ("seed_forces", "seed with forces (… and λ)"),
         ("four_bar", "four-bar (q, q̇, q̈)"),
         ("offset_slider", "offset slider (q)"),
     ] {
@@ -378,6 +411,16 @@ fn summary(fastest: &Fastest) {
             base * 1e9,
             cell(time("generated")),
             cell(time("dense"))
+        );
+    }
+    if let (Some(forces), Some(kinematics)) = (
+        fastest.get("seed_forces/generated"),
+        fastest.get("seed/generated"),
+    ) {
+        println!(
+            "  seed force solve: {:.1} ns per step ({:.2}× the kinematic step)",
+            (forces - kinematics) * 1e9,
+            forces / kinematics
         );
     }
     let safeguards = fastest.get("seed/safeguards/scaling+condition");
@@ -397,6 +440,7 @@ fn main() {
         .configure_from_args();
     let fastest = Fastest::default();
     seed(&mut c, &fastest);
+    seed_forces(&mut c, &fastest);
     four_bar(&mut c, &fastest);
     offset_slider(&mut c, &fastest);
     safeguards(&mut c, &fastest);

@@ -210,10 +210,15 @@ impl<M: Mechanism<Dim = Const<N>>, const N: usize> Revolution<M, N> {
              q {:.2e}   q̇ {:.2e}   q̈ {:.2e}",
             e.q, e.qd, e.qdd
         );
+        let work = if self.mechanism.outputs() == mechgen_runtime::Outputs::Forces {
+            "position + velocity + acceleration + forces"
+        } else {
+            "position + velocity + acceleration"
+        };
         let _ = writeln!(
             s,
-            "cost: {:.2} µs per step (position + velocity + acceleration; best of {} runs), \
-             {} steps, {:.2} Newton iterations per step",
+            "cost: {:.2} µs per step ({work}; best of {} runs), {} steps, {:.2} Newton \
+             iterations per step",
             self.seconds_per_step * 1e6,
             TIMING_REPETITIONS,
             steps,

@@ -93,7 +93,10 @@ where
             let solved = reverse(m, parts, options, length, motion, lambda, archive, archived);
             solved.and_then(|()| {
                 m.reactions(motion.q, motion.qd, lambda, reactions);
+                // The reactions are finite exactly when the multipliers are (and F, which
+                // the springs' pull on the frame shares): one check serves both.
                 check_finite(reactions, motion.t, Quantity::Reaction)
+                    .map_err(|_| non_finite_multiplier(m, lambda, motion.t))
             })
         }
         None => Err(non_finite(motion.t, Quantity::Reaction)),
@@ -127,7 +130,8 @@ where
 }
 
 /// The stages in reverse: each explicit stage's multipliers in closed form, each block's by a
-/// transposed solve.
+/// transposed solve. Finiteness is checked once, on the reactions (a NaN propagates into every
+/// multiplier that reads it); only a failure looks for where it began.
 #[allow(clippy::too_many_arguments)]
 fn reverse<M: Structured>(
     m: &M,
@@ -143,26 +147,20 @@ where
     DefaultAllocator: Storage<M::Dim>,
 {
     let Motion { t, q, qd, qdd } = *motion;
+    // The first block in reverse is the forward sweep's last: its scales are still set.
+    let mut scaled = true;
     for s in (0..m.stage_count()).rev() {
         match m.stage(s) {
-            Some(Stage::Explicit { equations, .. }) => {
+            Some(Stage::Explicit { .. }) => {
                 m.assign_multipliers(s, q, parts.trig, qd, qdd, lambda, t);
-                let bad = equations
-                    .iter()
-                    .find(|&&e| !lambda.get(e).is_some_and(|l| l.is_finite()));
-                if let Some(&equation) = bad {
-                    return Err(SolveError::NonFinite {
-                        time: t,
-                        quantity: Quantity::Reaction,
-                        equation: Some(equation),
-                    });
-                }
             }
             Some(Stage::Block(block)) => {
                 let bs = BlockSolve { m, stage: s, block };
                 let slots = block.slots;
                 end = end.saturating_sub(slots);
-                bs.set_scales(&mut parts.scales, length);
+                if !core::mem::replace(&mut scaled, false) {
+                    bs.set_scales(&mut parts.scales, length);
+                }
                 let stored =
                     parts.archived.get(s).copied().unwrap_or(false) && archive.len() >= end + slots;
                 let factors = if stored {
@@ -173,9 +171,6 @@ where
                 };
                 let rhs = &mut parts.newton.trial[..block.len()];
                 m.force_rhs(s, q, parts.trig, qd, qdd, lambda, t, rhs);
-                if !all_finite(rhs) {
-                    return Err(non_finite(t, Quantity::Load));
-                }
                 match factors {
                     None => {
                         bs.solve_transpose_static(&archive[end..end + slots], &parts.scales, rhs)
@@ -185,13 +180,6 @@ where
                     }
                 }
                 for (&x, &e) in rhs.iter().zip(block.equations) {
-                    if !x.is_finite() {
-                        return Err(SolveError::NonFinite {
-                            time: t,
-                            quantity: Quantity::Reaction,
-                            equation: Some(e),
-                        });
-                    }
                     if let Some(l) = lambda.get_mut(e) {
                         *l = x;
                     }
@@ -201,6 +189,29 @@ where
         }
     }
     Ok(())
+}
+
+/// The error for non-finite multipliers: the first stage's, in reverse solve order (where the
+/// NaN began), naming its first such equation.
+fn non_finite_multiplier<M: Structured>(m: &M, lambda: &[f64], t: f64) -> SolveError
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let first = (0..m.stage_count()).rev().find_map(|s| {
+        let equations = match m.stage(s)? {
+            Stage::Explicit { equations, .. } => equations,
+            Stage::Block(block) => block.equations,
+        };
+        equations
+            .iter()
+            .copied()
+            .find(|&e| !lambda.get(e).is_some_and(|l| l.is_finite()))
+    });
+    SolveError::NonFinite {
+        time: t,
+        quantity: Quantity::Reaction,
+        equation: first,
+    }
 }
 
 #[cfg(test)]
