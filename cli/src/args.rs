@@ -63,9 +63,10 @@ enum Sub {
         #[arg(long, value_enum, default_value_t = CheckFormat::Text)]
         format: CheckFormat,
     },
-    /// Solve positions, velocities and accelerations over time with the interpreter and the
-    /// runtime solver, and write them as CSV (columns t, then q, q_dot, q_ddot of every
-    /// coordinate) or JSON
+    /// Solve positions, velocities and accelerations (and the forces, for a scene with masses or
+    /// loads) over time with the interpreter and the runtime solver, and write them as CSV
+    /// (columns t, then q, q_dot, q_ddot of every coordinate, then each equation's reaction) or
+    /// JSON
     #[command(after_help = format!("{TIMES_HELP}\n\n{EXIT_STATUS}"))]
     Solve(SolveFlags),
     /// Print a completion script for a shell (e.g. `mechgen completions bash > mechgen.bash`)

@@ -1,5 +1,6 @@
 //! `mechgen check`: a readable summary of a compiled scene (coordinates, equations, degrees of
-//! freedom, Jacobian sparsity, length scale, parameters, branch invariants) and, with `--stats`,
+//! freedom, Jacobian sparsity, length scale, parameters, branch invariants, and what produces
+//! the forces and which reactions a scene with forces reports) and, with `--stats`,
 //! the solve structure (stages, block sizes, fill-in) and the operation counts of the generated
 //! functions.
 
@@ -41,6 +42,22 @@ pub struct Summary {
     pub parameters: Vec<Parameter>,
     /// Branch invariants as written.
     pub branches: Vec<Branch>,
+    /// For a scene that computes forces: what produces them and the reactions it reports.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub forces: Option<ForceSummary>,
+}
+
+/// What produces a scene's forces, and what it reports.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ForceSummary {
+    /// Moving bodies with mass properties.
+    pub bodies_with_mass: Vec<String>,
+    /// Gravity in world axes, with the parameters' defaults.
+    pub gravity: [f64; 2],
+    /// Loads by name.
+    pub loads: Vec<String>,
+    /// The reaction each equation reports, in Φ order (`crank_pin.fx`, …).
+    pub reactions: Vec<String>,
 }
 
 /// A parameter and its default.
@@ -118,6 +135,19 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
                 invariant: model.describe_branch(b),
             })
             .collect(),
+        forces: scene.forces.as_ref().map(|_| ForceSummary {
+            bodies_with_mass: model
+                .bodies
+                .iter()
+                .filter(|b| b.mass.is_some())
+                .map(|b| b.name.to_string())
+                .collect(),
+            gravity: model
+                .gravity
+                .map(|g| mechgen::interpret::eval(&model.arena, g, &env)),
+            loads: model.loads.iter().map(|l| l.name.clone()).collect(),
+            reactions: model.reaction_names(),
+        }),
     }
 }
 
@@ -209,6 +239,26 @@ fn write_report(out: &mut String, scene: &Scene, s: &Summary, stats: bool) -> fm
         for b in &s.branches {
             writeln!(out, "  {}: {}", b.name, b.invariant)?;
         }
+    }
+
+    if let Some(f) = &s.forces {
+        let list = |names: &[String]| {
+            if names.is_empty() {
+                "none".to_owned()
+            } else {
+                names.join(", ")
+            }
+        };
+        writeln!(
+            out,
+            "\nforces: masses on {}; gravity ({}, {}); loads: {}",
+            list(&f.bodies_with_mass),
+            f.gravity[0],
+            f.gravity[1],
+            list(&f.loads)
+        )?;
+        writeln!(out, "reactions ({}):", f.reactions.len())?;
+        numbered(out, &f.reactions)?;
     }
 
     if stats {

@@ -152,10 +152,11 @@ fn step_hint(error: &SolveError) -> &'static str {
 pub const DIAGNOSTIC_COLUMNS: &str = "iterations,substeps,evaluations,fallbacks,condition,det_sign";
 
 /// How `solve` writes its results. CSV: a header line, then one line per time (`t`, q, q_dot,
-/// q_ddot, and with `--diagnostics` the [`DIAGNOSTIC_COLUMNS`]). JSON: one document,
-/// `{"mechanism", "coordinates", "outputs", "states": [State…], "error"}`, each state as the
-/// runtime serialises it (`t`, `q`, `q_dot`, `q_ddot`, `iterations`, `evaluations`,
-/// `substeps`, `condition`, `fallbacks`, `det_sign`), and `error` `null` or
+/// q_ddot, the reactions of a scene with forces, and with `--diagnostics` the
+/// [`DIAGNOSTIC_COLUMNS`]). JSON: one document, `{"mechanism", "coordinates", "outputs",
+/// ["reactions",] "states": [State…], "error"}`, each state as the runtime serialises it (`t`,
+/// `q`, `q_dot`, `q_ddot`, `reactions`, `iterations`, `evaluations`, `substeps`, `condition`,
+/// `fallbacks`, `det_sign`), and `error` `null` or
 /// `{"step", "message", "kind"}`; written as the run goes, so a failed run still leaves a
 /// complete document. (The variants' docs are the CLI's help.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
@@ -193,11 +194,16 @@ impl Rows<'_> {
             Format::Json => {
                 let coordinates: Vec<&str> =
                     (0..m.len()).filter_map(|i| m.coordinate_name(i)).collect();
-                let head = serde_json::json!({
+                let mut head = serde_json::json!({
                     "mechanism": m.name(),
                     "coordinates": coordinates,
                     "outputs": m.outputs(),
                 });
+                let reactions: Vec<&str> =
+                    (0..m.len()).filter_map(|i| m.reaction_name(i)).collect();
+                if !reactions.is_empty() {
+                    head["reactions"] = serde_json::json!(reactions);
+                }
                 let head = head.to_string();
                 // `{…}` without its closing brace, then the states array.
                 self.line.push_str(&head[..head.len() - 1]);

@@ -507,3 +507,42 @@ fn json_output_is_one_document_even_when_a_step_fails() {
     assert_eq!(summary["degrees_of_freedom"], 1);
     assert_eq!(summary["parameters"][0]["name"], "omega");
 }
+
+#[test]
+fn a_scene_with_forces_reports_its_reactions_in_check_csv_and_json() {
+    let file = scene("piston_crank_dynamics.mech");
+    let check = mechgen(&["check", &file]);
+    let report = text(&check.stdout);
+    assert!(check.status.success(), "{}", text(&check.stderr));
+    assert!(report.contains("forces: masses on piston, rod, crank; gravity (0, -9810)"));
+    assert!(report.contains("14  crank_angle.effort"), "{report}");
+
+    let csv = mechgen(&["solve", &file, "--at", "0,0.001"]);
+    let header = text(&csv.stdout);
+    let header = header.lines().next().unwrap_or_default();
+    assert!(
+        header.ends_with(",slide.normal,slide.torque,crank_angle.effort"),
+        "{header}"
+    );
+    assert_eq!(header.split(',').count(), 1 + 4 * 15);
+
+    let json = mechgen(&["solve", &file, "--at", "0", "--format", "json"]);
+    let document: serde_json::Value =
+        serde_json::from_slice(&json.stdout).unwrap_or_else(|e| panic!("valid JSON: {e}"));
+    assert_eq!(document["reactions"][6], "crank_pin.fx");
+    assert_eq!(document["outputs"], "Forces");
+    let reactions = document["states"][0]["reactions"]
+        .as_array()
+        .map_or(0, Vec::len);
+    assert_eq!(reactions, 15);
+    // Without forces, no reactions anywhere.
+    let plain = mechgen(&[
+        "solve",
+        &scene("piston_crank.mech"),
+        "--at",
+        "0",
+        "--format",
+        "json",
+    ]);
+    assert!(!text(&plain.stdout).contains("reactions"));
+}

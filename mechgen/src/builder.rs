@@ -210,9 +210,9 @@ impl SceneBuilder {
         self
     }
 
-    /// `outputs …;`: which kinematic levels the generated code computes, up to and including
-    /// `outputs` (the default, without this call, is all three). A later call replaces an
-    /// earlier one.
+    /// `outputs …;`: which levels the generated code computes, up to and including `outputs`
+    /// (the default, without this call, is all it can: the three kinematic levels, and forces
+    /// when the scene has masses or loads). A later call replaces an earlier one.
     pub fn outputs(&mut self, outputs: Outputs) -> &mut Self {
         self.outputs = Some(outputs);
         self
@@ -242,6 +242,82 @@ impl SceneBuilder {
         self.check_name(name, &what);
         let guess = self.tuple(&guess, &what);
         self.push(format!("body {name} near {guess};"))
+    }
+
+    /// `body NAME near (x, y, angle) mass M inertia J centre (cx, cy);`: a moving body with its
+    /// mass, its moment of inertia about the centre of mass, and the centre in its frame (for a
+    /// scene that computes forces).
+    pub fn body_with_mass(
+        &mut self,
+        name: &str,
+        guess: [f64; 3],
+        mass: impl Into<Value>,
+        inertia: impl Into<Value>,
+        centre: [f64; 2],
+    ) -> &mut Self {
+        let what = format!("body `{name}`");
+        self.check_name(name, &what);
+        let guess = self.tuple(&guess, &what);
+        let (mass, inertia) = (
+            self.value(mass.into(), &what),
+            self.value(inertia.into(), &what),
+        );
+        let centre = self.tuple(&centre, &what);
+        self.push(format!(
+            "body {name} near {guess} mass {mass} inertia {inertia} centre {centre};"
+        ))
+    }
+
+    /// `gravity (gx, gy);`: the acceleration of gravity in world axes.
+    pub fn gravity(&mut self, gravity: [f64; 2]) -> &mut Self {
+        let gravity = self.tuple(&gravity, "gravity");
+        self.push(format!("gravity {gravity};"))
+    }
+
+    /// `load NAME: force(point) = (fx, fy);` in world axes, or with `local` in the body's axes
+    /// (`local_force`); the components may use `t` and parameters.
+    pub fn force(
+        &mut self,
+        name: &str,
+        point: impl Into<Point>,
+        [fx, fy]: [Value; 2],
+        local: bool,
+    ) -> &mut Self {
+        let what = format!("load `{name}`");
+        self.check_name(name, &what);
+        let point = self.point(point.into(), &what);
+        let (fx, fy) = (self.value(fx, &what), self.value(fy, &what));
+        let kind = if local { "local_force" } else { "force" };
+        self.push(format!("load {name}: {kind}({point}) = ({fx}, {fy});"))
+    }
+
+    /// `load NAME: torque(body) = value;`: a torque on a moving body.
+    pub fn torque(&mut self, name: &str, body: &str, value: impl Into<Value>) -> &mut Self {
+        let what = format!("load `{name}`");
+        self.check_name(name, &what);
+        self.check_name(body, &format!("the body of {what}"));
+        let value = self.value(value.into(), &what);
+        self.push(format!("load {name}: torque({body}) = {value};"))
+    }
+
+    /// `load NAME: spring(a, b, stiffness k, length L, damping c);`: a linear spring-damper
+    /// between two points (a zero stiffness or damping leaves that part out).
+    pub fn spring(
+        &mut self,
+        name: &str,
+        a: impl Into<Point>,
+        b: impl Into<Point>,
+        [stiffness, length, damping]: [Value; 3],
+    ) -> &mut Self {
+        let what = format!("load `{name}`");
+        self.check_name(name, &what);
+        let (a, b) = (self.point(a.into(), &what), self.point(b.into(), &what));
+        let [stiffness, length, damping] =
+            [stiffness, length, damping].map(|v| self.value(v, &what));
+        self.push(format!(
+            "load {name}: spring({a}, {b}, stiffness {stiffness}, length {length}, damping \
+             {damping});"
+        ))
     }
 
     /// `joint NAME: revolute(a, b);`: points `a` and `b` coincide (2 equations).
@@ -788,6 +864,45 @@ mod tests {
         );
         let messages = bad.build().expect_err("errors").messages();
         assert_eq!(messages.len(), 2, "{messages:#?}");
+    }
+
+    #[test]
+    fn masses_gravity_and_loads_round_trip() {
+        let mut scene = slider_crank();
+        scene
+            .body_with_mass("weight", [3.0, -1.0, 0.0], 2.0, "0.5 * omega", [0.1, 0.0])
+            .revolute("hang", "slider", ("weight", [0.0, 1.0]))
+            .driver_relative_angle("sway", "slider", "weight", "0.1 * sin(t)")
+            .gravity([0.0, -9.81])
+            .force(
+                "push",
+                ("slider", [0.0, 0.5]),
+                ["sin(t)".into(), 0.0.into()],
+                false,
+            )
+            .force("lift", "weight", [0.0.into(), 1.0.into()], true)
+            .torque("brake", "crank", "-0.1 * t")
+            .spring(
+                "coil",
+                "frame",
+                "weight",
+                [10.0.into(), 2.0.into(), 0.5.into()],
+            );
+        let text = scene.build().unwrap_or_else(|e| panic!("{e}"));
+        assert!(
+            text.contains(
+                "body weight near (3.0, -1.0, 0.0) mass 2.0 inertia 0.5 * omega centre (0.1, 0.0);"
+            ),
+            "{text}"
+        );
+        assert!(text.contains("load lift: local_force(weight) = (0.0, 1.0);"));
+        assert!(text.contains(
+            "load coil: spring(frame, weight, stiffness 10.0, length 2.0, damping 0.5);"
+        ));
+        let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        assert_eq!(compiled.model.outputs, crate::model::Outputs::Forces);
+        assert_eq!(compiled.model.loads.len(), 4);
+        assert!(compiled.forces.is_some());
     }
 
     #[test]

@@ -3,22 +3,45 @@
 //! (extreme and degenerate numbers, deleted, duplicated and rewired statements, stray
 //! characters), each run in-process through parse → check → the interpreter → assembly → a few
 //! steps. Every mutant must end in a compile error, a typed solve error, or states whose
-//! constraints hold: no panic, no `Ok` with a residual above tolerance, and a bounded number of
-//! evaluations (counted, not timed). [`run`] panics when a mutant breaks one of these, which is
+//! constraints hold (and whose reactions are finite, for a scene with forces): no panic, no
+//! `Ok` with a residual above tolerance, and a bounded number of evaluations (counted, not
+//! timed). [`run`] panics when a mutant breaks one of these, which is
 //! what both harnesses detect.
 
 use mechgen_cli::Interpreted;
 use mechgen_runtime::{
-    DEFAULT_MAX_HALVINGS, Mechanism, Simulation, Solver, SolverOptions, Stage, Structured, Unit,
-    Vector, nalgebra::Dyn,
+    DEFAULT_MAX_HALVINGS, Mechanism, Outputs, Simulation, Solver, SolverOptions, Stage, Structured,
+    Unit, Vector, nalgebra::Dyn,
 };
 
-/// The example scenes mutants are made from.
-pub const SCENES: [&str; 3] = [
+/// The scenes mutants are made from: the examples, and a slider-crank with every load kind
+/// (so that the force solve meets degenerate masses, springs and loads too).
+pub const SCENES: [&str; 5] = [
     include_str!("../../examples/scenes/piston_crank.mech"),
     include_str!("../../examples/scenes/four_bar.mech"),
     include_str!("../../examples/scenes/offset_slider.mech"),
+    include_str!("../../examples/scenes/piston_crank_dynamics.mech"),
+    LOADED,
 ];
+
+/// A slider-crank whose rod is a distance link, with offset centres of mass, gravity, a force
+/// in world and in body axes, a torque and a spring-damper.
+const LOADED: &str = "mechanism Loaded {
+    param omega = 20;
+    ground frame at (0, 0, 0);
+    body crank near (0, 0, 0.2) mass 2 inertia 0.01 centre (0.03, 0.01);
+    body slider near (0.33, 0, 0) mass 0.7 inertia 0.001 centre (0.01, 0.02);
+    joint pivot: revolute(frame, crank);
+    joint guide: prismatic(frame, slider, along (1, 0));
+    joint rod: distance(crank @ (0.1, 0), slider, 0.25);
+    driver spin: angle(crank) = 0.2 + omega * t;
+    branch ahead: dot(frame -> frame @ (1, 0), crank @ (0.1, 0) -> slider) > 0;
+    gravity (0, -9.81);
+    load gas: force(slider @ (0.01, 0)) = (-200 * (1 + sin(omega * t)), 0);
+    load nudge: local_force(crank @ (0.1, 0)) = (0, 3);
+    load brake: torque(crank) = -0.5 * t;
+    load coil: spring(frame @ (0.6, 0.1), slider, stiffness 500, length 0.2, damping 4);
+}";
 
 /// Values a number literal is replaced with: degenerate, extreme, and just out of range.
 const EXTREMES: [&str; 16] = [
@@ -232,6 +255,13 @@ pub fn run(source: &str, tally: &mut Tally) {
                     residual <= 100.0 * tolerance,
                     "Ok at t = {t} with scaled residual {residual:e}:\n{source}"
                 );
+                if names.outputs() == Outputs::Forces {
+                    let forces = state.constraint_forces();
+                    assert!(
+                        forces.iter().all(|f| f.is_finite()),
+                        "Ok at t = {t} with non-finite reactions:\n{source}"
+                    );
+                }
             }
             Err(error) => {
                 let text = error.describe(&names).to_string();

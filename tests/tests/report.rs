@@ -49,6 +49,19 @@ fn quick_report_writes_files_consistent_with_the_closed_form() {
         assert!(readme.contains(method.label()), "{method} missing");
     }
     assert!(readme.contains("## Summary") && readme.contains("How the numbers were measured"));
+    // The seed's force solve: every method against the closed-form inverse dynamics.
+    assert!(readme.contains("### Forces"));
+    let forces = report
+        .forces
+        .as_ref()
+        .expect("the seed ran, with its forces");
+    assert_eq!(forces.rows.len(), 3);
+    for row in &forces.rows {
+        let error = row.error.as_ref().unwrap_or_else(|e| panic!("{e}"));
+        assert!(*error <= 1e-10, "{}: {error:e}", row.method);
+        assert!(row.seconds_per_step.is_finite() && row.seconds_per_step > 0.0);
+    }
+    assert!(forces.kinematic.is_finite() && forces.kinematic > 0.0);
 
     // The measurements behind them.
     assert_eq!(report.scenes.len(), 2);

@@ -3,7 +3,8 @@
 //!
 //! [`run`] sweeps every [`Method`] over Newton tolerances, steps per revolution and the
 //! predictor ([`Plan`]), measures errors against the closed form and time per step, times the
-//! pieces of a step, and writes `README.md`, one SVG work-precision diagram per scene and
+//! pieces of a step, measures the seed's force solve against its closed-form inverse dynamics
+//! ([`forces`]), and writes `README.md`, one SVG work-precision diagram per scene and
 //! `points.csv` into the output directory. `cargo run --release --example report` is the
 //! command; the test `tests/tests/report.rs` runs it with [`Plan::quick`].
 //!
@@ -12,6 +13,7 @@
 
 pub mod chart;
 pub mod criterion;
+pub mod forces;
 pub mod markdown;
 pub mod methods;
 pub mod sweep;
@@ -209,6 +211,8 @@ pub struct Report {
     pub plan: Plan,
     /// One entry per scene run, in report order.
     pub scenes: Vec<SceneReport>,
+    /// The seed's force solve (run with the seed).
+    pub forces: Option<forces::ForceReport>,
     /// The output directory.
     pub out: PathBuf,
     /// Every file written.
@@ -258,6 +262,31 @@ impl Report {
             }
             s.push('\n');
         }
+        if let Some(forces) = &self.forces {
+            let _ = writeln!(
+                s,
+                "Seed with masses: the force solve — {}\n{:<22} {:>10} {:>10} {:>16}",
+                forces.setting, "method", "error", "µs/step", "× kinematic step"
+            );
+            for row in &forces.rows {
+                match &row.error {
+                    Ok(error) => {
+                        let _ = writeln!(
+                            s,
+                            "{:<22} {:>10.1e} {:>10.2} {:>16.2}",
+                            row.method.label(),
+                            error,
+                            row.seconds_per_step * 1e6,
+                            row.seconds_per_step / forces.kinematic
+                        );
+                    }
+                    Err(_) => {
+                        let _ = writeln!(s, "{:<22} {:>10}", row.method.label(), "failed");
+                    }
+                }
+            }
+            s.push('\n');
+        }
         let _ = writeln!(
             s,
             "report written to {} in {:.0} s",
@@ -287,9 +316,10 @@ pub fn run(
     let slugs: Vec<&'static str> = SCENES.into_iter().filter(|s| options.wants(s)).collect();
     // Per point an accuracy run and its timing; per method the micro-timings.
     let units_per_scene = Method::ALL.len() * (2 * plan.settings().len() + 1);
+    let with_forces = slugs.contains(&"seed");
     let mut counter = Counter {
         done: 0,
-        total: slugs.len() * units_per_scene,
+        total: slugs.len() * units_per_scene + usize::from(with_forces),
         progress,
     };
 
@@ -329,6 +359,12 @@ pub fn run(
         };
         scenes.push(report);
     }
+    let forces = if with_forces {
+        counter.start("seed", "the force solve".to_owned());
+        Some(forces::run(&plan)?)
+    } else {
+        None
+    };
     (counter.progress)(&Progress {
         done: counter.total,
         total: counter.total,
@@ -339,6 +375,7 @@ pub fn run(
     let mut report = Report {
         plan,
         scenes,
+        forces,
         out: options.out.clone(),
         files: Vec::new(),
         elapsed: Duration::ZERO,

@@ -292,7 +292,7 @@ impl Timing {
 }
 
 /// A simulation of `mechanism` at `setting`, assembled at t = 0.
-fn start<M>(mechanism: &M, setting: Setting) -> Result<Simulation<M>, SolveError>
+pub(super) fn start<M>(mechanism: &M, setting: Setting) -> Result<Simulation<M>, SolveError>
 where
     M: Structured + Accelerations + Clone,
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
