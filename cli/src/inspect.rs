@@ -86,11 +86,9 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
         .constraints
         .iter()
         .filter(|c| {
-            matches!(
+            !matches!(
                 c.kind,
-                ConstraintKind::Revolute { .. }
-                    | ConstraintKind::Prismatic { .. }
-                    | ConstraintKind::Distance { .. }
+                ConstraintKind::Ground { .. } | ConstraintKind::Driver { .. }
             )
         })
         .map(|c| c.kind.equation_suffixes().len())

@@ -41,6 +41,9 @@ pub struct Interpreted {
     /// names, present when the scene computes forces.
     forces: Option<(Tape, Tape)>,
     reaction_names: Vec<String>,
+    /// The markers' values: the textbook tape, the same reading the trig cache, and names.
+    markers: (Tape, Tape),
+    marker_names: Vec<String>,
     outputs: Outputs,
     /// Structural non-zeros of Φ_q, in the order the Jacobian tape produces them.
     pattern: Vec<(usize, usize)>,
@@ -272,6 +275,13 @@ impl Interpreted {
                 Tape::new(arena, &f.reactions),
             )
         });
+        let cached_markers = {
+            let reads = plan
+                .trig
+                .reads(arena, &kin.markers, plan.stages.len(), Phase::Final);
+            Tape::with_inputs(arena, &kin.markers, &reads)
+        };
+        let markers = (Tape::new(arena, &kin.markers), cached_markers);
         let force_storage = scene.forces.as_ref().map_or(0, |_| {
             model.dim() + plan.blocks().map(structure::Block::slots).sum::<usize>()
         });
@@ -290,6 +300,7 @@ impl Interpreted {
             .chain(&nu)
             .chain(&gamma)
             .chain(forces.iter().flat_map(|(f, r)| [f, r]))
+            .chain([&markers.0, &markers.1])
             .chain([&lengths, &geometry_values])
             .chain(&branches)
             .chain(&cached_branches)
@@ -303,6 +314,7 @@ impl Interpreted {
             .max(kin.length_scale.dependent.len())
             .max(kin.geometry.len())
             .max(plan.largest_block() + plan.largest_slots())
+            .max(kin.markers.len())
             .max(1);
         let [guess, phi, jacobian, phi_and_jacobian] = tapes;
         let outputs = match model.outputs {
@@ -325,6 +337,8 @@ impl Interpreted {
             gamma,
             forces,
             reaction_names: model.reaction_names(),
+            markers,
+            marker_names: model.marker_names(),
             outputs,
             pattern: kin.jacobian.iter().map(|e| (e.row, e.col)).collect(),
             coordinate_units: model.coordinate_units().into_iter().map(unit).collect(),
@@ -427,6 +441,29 @@ fn copy_into(values: &[f64], out: &mut Vector<Dyn>) {
 
 impl Mechanism for Interpreted {
     type Dim = Dyn;
+    type Markers = Vec<f64>;
+
+    fn marker_storage(&self) -> Vec<f64> {
+        vec![0.0; self.marker_names.len()]
+    }
+
+    fn marker_values(
+        &self,
+        q: &Vector<Dyn>,
+        qd: &Vector<Dyn>,
+        qdd: &Vector<Dyn>,
+        t: f64,
+        out: &mut Vec<f64>,
+    ) {
+        let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), &[], t);
+        self.run(&self.markers.0, inputs, |v| {
+            out.iter_mut().zip(v).for_each(|(o, v)| *o = *v);
+        });
+    }
+
+    fn marker_name(&self, index: usize) -> Option<&str> {
+        self.marker_names.get(index).map(String::as_str)
+    }
 
     fn dim(&self) -> Dyn {
         Dyn(self.coordinates.len())
@@ -756,6 +793,21 @@ impl Structured for Interpreted {
             value = v.first().copied().unwrap_or(f64::NAN)
         });
         value
+    }
+
+    fn markers(
+        &self,
+        q: &Vector<Dyn>,
+        trig: &[f64],
+        qd: &Vector<Dyn>,
+        qdd: &Vector<Dyn>,
+        t: f64,
+        out: &mut Vec<f64>,
+    ) {
+        let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t);
+        self.run(&self.markers.1, inputs, |v| {
+            out.iter_mut().zip(v).for_each(|(o, v)| *o = *v);
+        });
     }
 
     fn factor(&self, stage: usize, values: &mut [f64], tiny: f64, limit: f64) -> Result<(), usize> {

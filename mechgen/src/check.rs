@@ -6,6 +6,8 @@
 //! (mass properties, gravity, loads) is checked in `check/dynamics.rs`.
 
 mod dynamics;
+mod functions;
+mod library;
 
 use std::collections::HashMap;
 
@@ -13,13 +15,11 @@ use proc_macro2::Span;
 use syn::Ident;
 
 use crate::error::Errors;
-use crate::expr::{Arena, Func, Id, Node, Var};
+use crate::expr::{Arena, Id, Node, Var};
 use crate::graph::{self, UNMATCHED};
-use crate::model::{
-    Body, Branch, Constraint, ConstraintKind, Driven, Model, Outputs, Param, Point,
-};
+use crate::model::{Body, Branch, Constraint, ConstraintKind, Model, Outputs, Param, Point};
 use crate::resolution::{self, Lengths};
-use crate::spec::{BinOp, BranchDecl, DriverKind, Expr, ExprKind, JointKind, PointRef, Spec};
+use crate::spec::{BinOp, BranchDecl, Expr, ExprKind, PointRef, Spec};
 
 /// Checks a spec and builds its model.
 ///
@@ -118,6 +118,11 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
         .collect();
     let gravity = cx.gravity(spec);
     let loads = spec.loads.iter().filter_map(|decl| cx.load(decl)).collect();
+    let markers = spec
+        .markers
+        .iter()
+        .filter_map(|decl| cx.marker(decl))
+        .collect();
     cx.check_forces(spec, outputs);
     // A rejected joint or driver would make the degree-of-freedom count misleading: count only a
     // scene whose parts all checked.
@@ -133,6 +138,7 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
         branches,
         gravity,
         loads,
+        markers,
         outputs,
     };
     if count {
@@ -170,13 +176,19 @@ impl Checker {
             .chain(spec.joints.iter().map(|j| (&j.name, "joint")))
             .chain(spec.drivers.iter().map(|d| (&d.name, "driver")))
             .chain(spec.branches.iter().map(|b| (&b.name, "branch")))
-            .chain(spec.loads.iter().map(|l| (&l.name, "load")));
+            .chain(spec.loads.iter().map(|l| (&l.name, "load")))
+            .chain(spec.markers.iter().map(|m| (&m.name, "marker")));
         for (name, what) in names {
             let key = name.to_string();
-            if key == "t" {
+            if key == "t" || key == "pi" {
+                let meaning = if key == "t" {
+                    "`t` is time"
+                } else {
+                    "`pi` is π"
+                };
                 self.errors.push(
                     name.span(),
-                    format!("`t` is time; give this {what} another name"),
+                    format!("{meaning}; give this {what} another name"),
                 );
                 continue;
             }
@@ -185,7 +197,7 @@ impl Checker {
                     name.span(),
                     format!(
                         "duplicate name `{key}`: a {first} of that name is declared above; \
-                         every parameter, body, joint, driver, branch and load needs its own name"
+                         every parameter, body, joint, driver, branch, load and marker needs its own name"
                     ),
                 );
             } else {
@@ -244,21 +256,8 @@ impl Checker {
     /// Names every moving body that no joint joins and no driver moves: it floats freely, and
     /// the degree-of-freedom count would blame the drivers for it. Returns whether there is one.
     fn check_floating(&mut self, spec: &Spec) -> bool {
-        let joined = |body: &Ident| {
-            spec.joints.iter().any(|j| match &j.kind {
-                JointKind::Revolute { a, b }
-                | JointKind::Prismatic { a, b, .. }
-                | JointKind::Distance { a, b, .. } => a.body == *body || b.body == *body,
-            })
-        };
-        let driven = |body: &Ident| {
-            spec.drivers.iter().any(|d| match &d.kind {
-                DriverKind::Angle(b) => b == body,
-                DriverKind::RelativeAngle(a, b) => a == body || b == body,
-                DriverKind::X(p) | DriverKind::Y(p) => p.body == *body,
-                DriverKind::Travel(_) => false,
-            })
-        };
+        let joined = |body: &Ident| spec.joints.iter().any(|j| j.kind.bodies().contains(&body));
+        let driven = |body: &Ident| spec.drivers.iter().any(|d| d.kind.bodies().contains(&body));
         let anchor = spec
             .bodies
             .iter()
@@ -318,160 +317,6 @@ impl Checker {
             None => [self.arena.zero(), self.arena.zero()],
         };
         Some(Point { body, local })
-    }
-
-    fn two_points(&mut self, a: &PointRef, b: &PointRef) -> Option<(Point, Point)> {
-        let (pa, pb) = (self.point(a), self.point(b));
-        let (pa, pb) = (pa?, pb?);
-        if pa.body == pb.body {
-            self.errors.push(
-                b.body.span(),
-                format!(
-                    "this joint connects `{}` to itself; join two different bodies",
-                    a.body
-                ),
-            );
-            return None;
-        }
-        if self.ground[pa.body] && self.ground[pb.body] {
-            self.errors.push(
-                b.body.span(),
-                format!(
-                    "this joint connects two ground bodies (`{}` and `{}`), which cannot move; \
-                     connect at least one moving body",
-                    a.body, b.body
-                ),
-            );
-            return None;
-        }
-        Some((pa, pb))
-    }
-
-    fn joint(&mut self, name: &Ident, kind: &JointKind) -> Option<ConstraintKind> {
-        match kind {
-            JointKind::Revolute { a, b } => {
-                let (a, b) = self.two_points(a, b)?;
-                Some(ConstraintKind::Revolute { a, b })
-            }
-            JointKind::Prismatic {
-                a,
-                b,
-                axis,
-                axis_span,
-            } => {
-                let points = self.two_points(a, b);
-                let ux = self.geometry(&axis[0]);
-                let uy = self.geometry(&axis[1]);
-                let (ux2, uy2) = (self.arena.powi(ux, 2), self.arena.powi(uy, 2));
-                let norm2 = self.arena.add(ux2, uy2);
-                if self.arena.as_const(norm2) == Some(0.0) {
-                    self.errors.push(
-                        *axis_span,
-                        "the axis is the zero vector; give a direction such as `along (1, 0)`",
-                    );
-                    return None;
-                }
-                let norm = self.arena.call(Func::Sqrt, norm2);
-                let axis = [self.arena.div(ux, norm), self.arena.div(uy, norm)];
-                let (a, b) = points?;
-                self.prismatic.insert(name.to_string(), (a, b, axis));
-                Some(ConstraintKind::Prismatic { a, b, axis })
-            }
-            JointKind::Distance { a, b, length } => {
-                let points = self.two_points(a, b);
-                let value = self.length(length);
-                match self.arena.as_const(value) {
-                    Some(0.0) => {
-                        self.errors.push(
-                            length.span,
-                            "a distance of zero makes the constraint degenerate (its Jacobian \
-                             vanishes); use `revolute` to make two points coincide",
-                        );
-                        return None;
-                    }
-                    Some(negative) if negative < 0.0 => {
-                        self.errors.push(
-                            length.span,
-                            format!(
-                                "a distance is a length between two points and cannot be \
-                                 negative; write {}",
-                                -negative
-                            ),
-                        );
-                        return None;
-                    }
-                    _ => {}
-                }
-                let (a, b) = points?;
-                Some(ConstraintKind::Distance {
-                    a,
-                    b,
-                    length: value,
-                })
-            }
-        }
-    }
-
-    fn moving(&mut self, name: &Ident, what: &str) -> Option<usize> {
-        let body = self.body(name)?;
-        if self.ground[body] {
-            self.errors.push(
-                name.span(),
-                format!(
-                    "cannot drive {what} of `{name}`: it is a ground body and never moves; \
-                     drive a moving body (declared with `body`)"
-                ),
-            );
-            return None;
-        }
-        Some(body)
-    }
-
-    fn driven(&mut self, span: Span, kind: &DriverKind) -> Option<Driven> {
-        match kind {
-            DriverKind::Angle(body) => Some(Driven::Angle(self.moving(body, "the angle")?)),
-            DriverKind::RelativeAngle(a, b) => {
-                let (ia, ib) = (self.body(a), self.body(b));
-                let (ia, ib) = (ia?, ib?);
-                if ia == ib {
-                    self.errors.push(
-                        b.span(),
-                        format!("relative angle of `{a}` to itself; name two different bodies"),
-                    );
-                    return None;
-                }
-                if self.ground[ia] && self.ground[ib] {
-                    self.errors.push(
-                        span,
-                        "both bodies are ground bodies and never move; drive a moving body",
-                    );
-                    return None;
-                }
-                Some(Driven::RelativeAngle(ia, ib))
-            }
-            DriverKind::X(p) | DriverKind::Y(p) => {
-                self.moving(&p.body, "a point")?;
-                let point = self.point(p)?;
-                Some(if matches!(kind, DriverKind::X(_)) {
-                    Driven::X(point)
-                } else {
-                    Driven::Y(point)
-                })
-            }
-            DriverKind::Travel(joint) => match self.prismatic.get(&joint.to_string()) {
-                Some(&(a, b, axis)) => Some(Driven::Travel { a, b, axis }),
-                None => {
-                    self.errors.push(
-                        joint.span(),
-                        format!(
-                            "`{joint}` is not a prismatic joint declared before this driver; \
-                             `travel` drives the slider of a `prismatic` joint"
-                        ),
-                    );
-                    None
-                }
-            },
-        }
     }
 
     /// A branch invariant: known bodies, points without `t`, the literal 0 on the right, no
@@ -552,14 +397,7 @@ impl Checker {
             return;
         }
         let moving = spec.bodies.iter().filter(|b| !b.ground).count();
-        let joint_equations: usize = spec
-            .joints
-            .iter()
-            .map(|j| match j.kind {
-                JointKind::Revolute { .. } | JointKind::Prismatic { .. } => 2,
-                JointKind::Distance { .. } => 1,
-            })
-            .sum();
+        let joint_equations: usize = spec.joints.iter().map(|j| j.kind.equations()).sum();
         let dof = 3 * moving as i64 - joint_equations as i64;
         let drivers = spec.drivers.len() as i64;
         let count = format!(
@@ -755,6 +593,9 @@ impl Checker {
             ExprKind::Number(v) => self.arena.constant(*v),
             ExprKind::Name(name) => {
                 let key = name.to_string();
+                if key == "pi" {
+                    return self.arena.constant(core::f64::consts::PI);
+                }
                 if key == "t" {
                     if !allow_t {
                         self.errors.push(
@@ -829,35 +670,19 @@ impl Checker {
                 );
                 result
             }
-            ExprKind::Call(f, a) => {
-                let arg = self.lower_with(a, allow_params, allow_t);
-                match Func::from_name(&f.to_string()) {
-                    Some(func) => {
-                        let result = self.arena.call(func, arg);
-                        let hint = match func {
-                            Func::Sqrt => "`sqrt` needs an argument ≥ 0",
-                            Func::Ln => "`ln` needs a positive argument",
-                            Func::Tan => "`tan` is infinite at odd multiples of π/2",
-                            _ => "the result overflows an f64",
-                        };
-                        self.check_folded(e.span, result, &[arg], hint);
-                        result
-                    }
-                    None => {
-                        let names: Vec<String> = Func::ALL
-                            .iter()
-                            .map(|f| format!("`{}`", f.name()))
-                            .collect();
-                        self.errors.push(
-                            f.span(),
-                            format!(
-                                "unknown function `{f}`; supported functions are {}",
-                                names.join(", ")
-                            ),
-                        );
-                        self.arena.zero()
-                    }
-                }
+            ExprKind::Call(f, args) => self.call(e.span, f, args, allow_params, allow_t),
+            ExprKind::RealPow(base, exponent) => {
+                let base = self.lower_with(base, allow_params, allow_t);
+                let exponent = self.lower_with(exponent, allow_params, allow_t);
+                self.real_power(e.span, base, exponent)
+            }
+            ExprKind::Tuple(_) => {
+                self.errors.push(
+                    e.span,
+                    "a pair `(x, y)` only appears as a spline's point, as in \
+                     `spline(t, (0, 0), (1, 2))`",
+                );
+                self.arena.zero()
             }
         }
     }

@@ -7,7 +7,7 @@
 
 use std::collections::HashMap;
 
-use crate::expr::{Arena, Func, Id, Node, Var};
+use crate::expr::{Arena, Func, Func2, Id, Node, Var};
 
 /// Differentiates expressions of one arena, remembering what it has done.
 #[derive(Debug, Default)]
@@ -72,6 +72,24 @@ impl Differentiator {
                     arena.mul(outer, da)
                 }
             }
+            Node::Call2(f, a, b) => {
+                let (da, db) = (self.diff(arena, a, var), self.diff(arena, b, var));
+                binary_derivative(arena, f, [a, b], [da, db], e)
+            }
+            // The selected branch's derivative: at a = b, the `x` branch's (one-sided).
+            Node::Select(a, b, x, y) => {
+                let (dx, dy) = (self.diff(arena, x, var), self.diff(arena, y, var));
+                arena.select(a, b, dx, dy)
+            }
+            Node::Spline { table, order, x } => {
+                let dx = self.diff(arena, x, var);
+                if arena.is_zero(dx) && arena.simplifies() {
+                    arena.zero()
+                } else {
+                    let outer = arena.spline(table, order.saturating_add(1), x);
+                    arena.mul(outer, dx)
+                }
+            }
         };
         self.memo.insert((e, var), d);
         d
@@ -120,6 +138,49 @@ fn outer_derivative(arena: &mut Arena, f: Func, a: Id, e: Id) -> Id {
             let one = arena.one();
             arena.div(one, twice)
         }
+        // ±1/√(1 − a²): infinite at ±1, where the solver then reports a non-finite Jacobian.
+        Func::Asin | Func::Acos => {
+            let one = arena.one();
+            let square = arena.powi(a, 2);
+            let rest = arena.sub(one, square);
+            let root = arena.call(Func::Sqrt, rest);
+            let inverse = arena.div(one, root);
+            if f == Func::Asin {
+                inverse
+            } else {
+                arena.neg(inverse)
+            }
+        }
+    }
+}
+
+/// d f(a, b) for `e = f(a, b)`, given `da` and `db`.
+fn binary_derivative(arena: &mut Arena, f: Func2, [a, b]: [Id; 2], [da, db]: [Id; 2], e: Id) -> Id {
+    match f {
+        // atan2(y, x): (x dy − y dx) / (x² + y²).
+        Func2::Atan2 => {
+            let (x_dy, y_dx) = (arena.mul(b, da), arena.mul(a, db));
+            let numerator = arena.sub(x_dy, y_dx);
+            let (xx, yy) = (arena.powi(b, 2), arena.powi(a, 2));
+            let denominator = arena.add(xx, yy);
+            arena.div(numerator, denominator)
+        }
+        // a^b: b a^(b−1) da, plus a^b ln(a) db when the exponent varies.
+        Func2::Pow => {
+            let one = arena.one();
+            let lowered_exponent = arena.sub(b, one);
+            let lowered = arena.call2(Func2::Pow, a, lowered_exponent);
+            let factor = arena.mul(b, lowered);
+            let base_term = arena.mul(factor, da);
+            if arena.is_zero(db) && arena.simplifies() {
+                base_term
+            } else {
+                let log = arena.call(Func::Ln, a);
+                let scaled = arena.mul(e, log);
+                let exponent_term = arena.mul(scaled, db);
+                arena.add(base_term, exponent_term)
+            }
+        }
     }
 }
 
@@ -158,6 +219,21 @@ mod tests {
         }
         let quotient = a.div(x, y);
         cases.push(quotient);
+        let small = a.constant(0.3);
+        let scaled = a.mul(small, x);
+        cases.push(a.call(Func::Asin, scaled));
+        cases.push(a.call(Func::Acos, scaled));
+        cases.push(a.call2(Func2::Atan2, y, x));
+        cases.push(a.call2(Func2::Pow, x, y));
+        let half = a.constant(2.5);
+        cases.push(a.call2(Func2::Pow, y, half));
+        cases.push(a.select(x, y, quotient, scaled));
+        let table =
+            crate::spline::SplineTable::natural(&[0.0, 0.5, 1.0, 2.0], &[1.0, 0.2, 0.4, -1.0])
+                .expect("a valid spline");
+        let table = a.add_spline(table);
+        let product = a.mul(x, y);
+        cases.push(a.spline(table, 0, product));
         cases.push(a.powi(x, 3));
         cases.push(a.powi(y, -2));
         let st = a.sin(t);

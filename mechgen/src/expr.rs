@@ -37,7 +37,7 @@ pub enum Var {
     T,
 }
 
-/// Elementary functions of the spec language.
+/// Elementary functions of one argument.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Func {
     /// Sine.
@@ -52,17 +52,23 @@ pub enum Func {
     Ln,
     /// Square root.
     Sqrt,
+    /// Arcsine, in [−π/2, π/2].
+    Asin,
+    /// Arccosine, in [0, π].
+    Acos,
 }
 
 impl Func {
-    /// Every function, for error messages.
-    pub const ALL: [Func; 6] = [
+    /// Every function.
+    pub const ALL: [Func; 8] = [
         Func::Sin,
         Func::Cos,
         Func::Tan,
         Func::Exp,
         Func::Ln,
         Func::Sqrt,
+        Func::Asin,
+        Func::Acos,
     ];
 
     /// The name used in specs and in generated code (`::mechgen_runtime::math::NAME`).
@@ -74,6 +80,8 @@ impl Func {
             Func::Exp => "exp",
             Func::Ln => "ln",
             Func::Sqrt => "sqrt",
+            Func::Asin => "asin",
+            Func::Acos => "acos",
         }
     }
 
@@ -91,7 +99,49 @@ impl Func {
             Func::Exp => x.exp(),
             Func::Ln => x.ln(),
             Func::Sqrt => x.sqrt(),
+            Func::Asin => x.asin(),
+            Func::Acos => x.acos(),
         }
+    }
+}
+
+/// Elementary functions of two arguments.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Func2 {
+    /// `atan2(y, x)`: the angle of the vector (x, y), in (−π, π].
+    Atan2,
+    /// `pow(a, b)` = a^b for a real exponent (NaN for a negative base).
+    Pow,
+}
+
+impl Func2 {
+    /// The name in generated code (`::mechgen_runtime::math::NAME`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Func2::Atan2 => "atan2",
+            Func2::Pow => "pow",
+        }
+    }
+
+    /// Evaluates the function (constant folding, the interpreter).
+    pub fn apply(self, a: f64, b: f64) -> f64 {
+        match self {
+            Func2::Atan2 => a.atan2(b),
+            Func2::Pow => a.powf(b),
+        }
+    }
+}
+
+/// `if a <= b { x } else { y }`, and NaN (`a + b`) when `a` or `b` is NaN: the one branching
+/// node (min, max, abs and the clamped motion laws lower to it), shared by folding and the
+/// interpreter; generated code calls `::mechgen_runtime::math::select`, the same rule.
+pub fn select(a: f64, b: f64, x: f64, y: f64) -> f64 {
+    if a <= b {
+        x
+    } else if b < a {
+        y
+    } else {
+        a + b
     }
 }
 
@@ -118,6 +168,21 @@ pub enum Node {
     Powi(Id, i32),
     /// f(a)
     Call(Func, Id),
+    /// f(a, b)
+    Call2(Func2, Id, Id),
+    /// `if a <= b { x } else { y }` (see [`select`]): its derivative is the selected branch's,
+    /// so at a kink (a = b) it is the one-sided derivative of the `x` branch.
+    Select(Id, Id, Id, Id),
+    /// The `order`-th derivative (0: the value) of spline table `table` at `x`
+    /// ([`Arena::spline_table`]).
+    Spline {
+        /// Index of the table in the arena.
+        table: u32,
+        /// Derivative order, 0 to 3.
+        order: u8,
+        /// The argument.
+        x: Id,
+    },
 }
 
 /// The arena holding every node; see the module docs.
@@ -129,6 +194,8 @@ pub struct Arena {
     one: Id,
     /// False only for the naive baseline ([`Arena::unsimplified`]).
     simplify: bool,
+    /// The spline tables [`Node::Spline`] refers to.
+    splines: Vec<crate::spline::SplineTable>,
 }
 
 impl Default for Arena {
@@ -146,6 +213,7 @@ impl Arena {
             zero: Id(0),
             one: Id(0),
             simplify: true,
+            splines: Vec::new(),
         };
         arena.zero = arena.intern(Node::Const(0f64.to_bits()));
         arena.one = arena.intern(Node::Const(1f64.to_bits()));
@@ -418,16 +486,80 @@ impl Arena {
         self.call(Func::Cos, a)
     }
 
+    /// f(a, b)
+    pub fn call2(&mut self, f: Func2, a: Id, b: Id) -> Id {
+        if !self.simplify {
+            return self.intern(Node::Call2(f, a, b));
+        }
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(x), Some(y)) => self.fold_or(f.apply(x, y), Node::Call2(f, a, b)),
+            // a^1 = a, a^0 = 1 (for every a, as powf has it).
+            (_, Some(1.0)) if f == Func2::Pow => a,
+            (_, Some(0.0)) if f == Func2::Pow => self.one,
+            _ => self.intern(Node::Call2(f, a, b)),
+        }
+    }
+
+    /// `if a <= b { x } else { y }` (see [`select`]).
+    pub fn select(&mut self, a: Id, b: Id, x: Id, y: Id) -> Id {
+        if !self.simplify {
+            return self.intern(Node::Select(a, b, x, y));
+        }
+        match (self.as_const(a), self.as_const(b)) {
+            (Some(p), Some(q)) if p <= q => x,
+            (Some(p), Some(q)) if q < p => y,
+            _ if x == y => x,
+            _ => self.intern(Node::Select(a, b, x, y)),
+        }
+    }
+
+    /// Adds a spline table, returning its index for [`Arena::spline`].
+    pub fn add_spline(&mut self, table: crate::spline::SplineTable) -> u32 {
+        self.splines.push(table);
+        u32::try_from(self.splines.len() - 1).expect("spline tables exceed u32")
+    }
+
+    /// The spline tables, by index.
+    pub fn spline_tables(&self) -> &[crate::spline::SplineTable] {
+        &self.splines
+    }
+
+    /// Spline table `table`, if it exists.
+    pub fn spline_table(&self, table: u32) -> Option<&crate::spline::SplineTable> {
+        self.splines.get(table as usize)
+    }
+
+    /// The `order`-th derivative of spline `table` at `x` (zero beyond the third: the cubic's
+    /// fourth derivative).
+    pub fn spline(&mut self, table: u32, order: u8, x: Id) -> Id {
+        if order > 3 && self.simplify {
+            return self.zero;
+        }
+        let node = Node::Spline { table, order, x };
+        match (self.simplify, self.as_const(x), self.spline_table(table)) {
+            (true, Some(value), Some(spline)) => {
+                let folded = spline.eval(value, order);
+                self.fold_or(folded, node)
+            }
+            _ => self.intern(node),
+        }
+    }
+
     /// The operands of a node, in order.
     pub fn children(&self, id: Id) -> impl Iterator<Item = Id> {
-        let (a, b) = match self.node(id) {
-            Node::Const(_) | Node::Param(_) | Node::Var(_) => (None, None),
-            Node::Neg(a) | Node::Powi(a, _) | Node::Call(_, a) => (Some(a), None),
-            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => {
-                (Some(a), Some(b))
+        let operands: [Option<Id>; 4] = match self.node(id) {
+            Node::Const(_) | Node::Param(_) | Node::Var(_) => [None; 4],
+            Node::Neg(a) | Node::Powi(a, _) | Node::Call(_, a) | Node::Spline { x: a, .. } => {
+                [Some(a), None, None, None]
             }
+            Node::Add(a, b)
+            | Node::Sub(a, b)
+            | Node::Mul(a, b)
+            | Node::Div(a, b)
+            | Node::Call2(_, a, b) => [Some(a), Some(b), None, None],
+            Node::Select(a, b, x, y) => [Some(a), Some(b), Some(x), Some(y)],
         };
-        a.into_iter().chain(b)
+        operands.into_iter().flatten()
     }
 
     /// `e` with every variable of `map` replaced by its expression, rebuilt through the
@@ -457,6 +589,9 @@ impl Arena {
                 Node::Div(a, b) => self.div(get(a), get(b)),
                 Node::Powi(a, n) => self.powi(get(a), n),
                 Node::Call(f, a) => self.call(f, get(a)),
+                Node::Call2(f, a, b) => self.call2(f, get(a), get(b)),
+                Node::Select(a, b, x, y) => self.select(get(a), get(b), get(x), get(y)),
+                Node::Spline { table, order, x } => self.spline(table, order, get(x)),
             };
             memo.insert(id, rebuilt);
         }

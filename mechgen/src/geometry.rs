@@ -91,12 +91,17 @@ fn values(kind: &ConstraintKind) -> Vec<(Id, Requirement)> {
             values.push((pose[2], Requirement::Angle));
         }
         ConstraintKind::Prismatic { axis, .. }
+        | ConstraintKind::Slot { axis, .. }
+        | ConstraintKind::Rack { axis, .. }
         | ConstraintKind::Driver {
             driven: Driven::Travel { axis, .. },
             ..
         } => values.extend(axis.map(|id| (id, Requirement::Axis))),
         ConstraintKind::Distance { length, .. } => values.push((length, Requirement::Distance)),
-        ConstraintKind::Revolute { .. } | ConstraintKind::Driver { .. } => {}
+        ConstraintKind::Weld { angle, .. } => values.push((angle, Requirement::Angle)),
+        ConstraintKind::Revolute { .. }
+        | ConstraintKind::Gear { .. }
+        | ConstraintKind::Driver { .. } => {}
     }
     values
 }

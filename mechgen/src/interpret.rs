@@ -12,7 +12,8 @@
 use core::ops::{Add, Div, Mul, Neg, Sub};
 use std::collections::{HashMap, HashSet};
 
-use crate::expr::{Arena, Func, Id, Node, Var};
+use crate::expr::{Arena, Func, Func2, Id, Node, Var};
+use crate::spline::SplineTable;
 
 /// A number type a [`Tape`] can evaluate over: `f64`, or e.g. a dual number for forward-mode
 /// automatic differentiation (implemented by a newtype in the crate that owns the dual type).
@@ -30,6 +31,11 @@ pub trait Scalar:
     fn powi(self, n: i32) -> Self;
     /// One of the IR's elementary functions.
     fn apply(self, function: Func) -> Self;
+    /// One of the IR's functions of two arguments.
+    fn apply2(self, function: Func2, other: Self) -> Self;
+    /// The plain value (a dual number's real part): what [`Node::Select`] compares and a
+    /// spline is evaluated at.
+    fn primal(self) -> f64;
 }
 
 impl Scalar for f64 {
@@ -44,6 +50,14 @@ impl Scalar for f64 {
     #[inline]
     fn apply(self, function: Func) -> Self {
         function.apply(self)
+    }
+    #[inline]
+    fn apply2(self, function: Func2, other: Self) -> Self {
+        function.apply(self, other)
+    }
+    #[inline]
+    fn primal(self) -> f64 {
+        self
     }
 }
 
@@ -128,6 +142,10 @@ enum Op {
     Div(usize, usize),
     Powi(usize, i32),
     Call(crate::expr::Func, usize),
+    Call2(Func2, usize, usize),
+    Select(usize, usize, usize, usize),
+    /// A spline table (index into the tape's own), derivative order, argument.
+    Spline(usize, u8, usize),
 }
 
 /// A set of outputs compiled to straight-line instructions.
@@ -135,6 +153,8 @@ enum Op {
 pub struct Tape {
     ops: Vec<Op>,
     outputs: Vec<usize>,
+    /// The spline tables the tape reads (copied, so a tape stands alone).
+    splines: Vec<SplineTable>,
 }
 
 impl Tape {
@@ -151,6 +171,8 @@ impl Tape {
         // stage of large scenes.
         let mut slot: HashMap<Id, usize> = HashMap::with_capacity(order.len());
         let mut ops = Vec::with_capacity(order.len());
+        let mut splines = Vec::new();
+        let mut copied: HashMap<u32, usize> = HashMap::new();
         for &id in &order {
             let s = |x: Id| slot.get(&x).copied().unwrap_or(usize::MAX);
             let op = match arena.node(id) {
@@ -169,6 +191,19 @@ impl Tape {
                 Node::Div(a, b) => Op::Div(s(a), s(b)),
                 Node::Powi(a, n) => Op::Powi(s(a), n),
                 Node::Call(f, a) => Op::Call(f, s(a)),
+                Node::Call2(f, a, b) => Op::Call2(f, s(a), s(b)),
+                Node::Select(a, b, x, y) => Op::Select(s(a), s(b), s(x), s(y)),
+                Node::Spline { table, order, x } => {
+                    let index = *copied.entry(table).or_insert_with(|| {
+                        let copy = arena.spline_table(table).cloned().unwrap_or(SplineTable {
+                            knots: vec![f64::NAN],
+                            segments: vec![[f64::NAN; 4]; 2],
+                        });
+                        splines.push(copy);
+                        splines.len() - 1
+                    });
+                    Op::Spline(index, order, s(x))
+                }
             };
             slot.insert(id, ops.len());
             ops.push(op);
@@ -177,7 +212,11 @@ impl Tape {
             .iter()
             .map(|r| slot.get(r).copied().unwrap_or(usize::MAX))
             .collect();
-        Tape { ops, outputs }
+        Tape {
+            ops,
+            outputs,
+            splines,
+        }
     }
 
     /// A scratch buffer of the right size for [`Tape::eval`].
@@ -240,6 +279,26 @@ impl Tape {
                 Op::Div(a, b) => scratch[a] / scratch[b],
                 Op::Powi(a, n) => scratch[a].powi(n),
                 Op::Call(f, a) => scratch[a].apply(f),
+                Op::Call2(f, a, b) => scratch[a].apply2(f, scratch[b]),
+                Op::Select(a, b, x, y) => {
+                    let (p, q) = (scratch[a].primal(), scratch[b].primal());
+                    if p <= q {
+                        scratch[x]
+                    } else if q < p {
+                        scratch[y]
+                    } else {
+                        scratch[a] + scratch[b]
+                    }
+                }
+                Op::Spline(table, order, a) => {
+                    // Value and slope at the primal point: exact for f64, first order for
+                    // dual numbers (what forward-mode differentiation needs).
+                    let x = scratch[a];
+                    let p = x.primal();
+                    let spline = &self.splines[table];
+                    let (value, slope) = (spline.eval(p, order), spline.eval(p, order + 1));
+                    S::from_f64(value) + S::from_f64(slope) * (x - S::from_f64(p))
+                }
             };
             scratch[i] = value;
         }
@@ -364,6 +423,12 @@ mod tests {
                 _ => f64::NAN,
             };
             D(function.apply(self.0), derivative * self.1)
+        }
+        fn apply2(self, function: Func2, other: Self) -> Self {
+            D(function.apply(self.0, other.0), f64::NAN)
+        }
+        fn primal(self) -> f64 {
+            self.0
         }
     }
 

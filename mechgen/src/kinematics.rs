@@ -41,6 +41,8 @@ pub struct Kinematics {
     pub length_scale: LengthScale,
     /// The geometry written in parameters, with the rule each value must satisfy at run time.
     pub geometry: Vec<crate::geometry::Check>,
+    /// The markers' values and rates, in layout order ([`Model::marker_names`]).
+    pub markers: Vec<Id>,
 }
 
 /// The largest magnitude among a scene's geometric lengths ([`Model::lengths`]), split into what
@@ -146,6 +148,7 @@ pub fn derive(model: &mut Model) -> Kinematics {
     let branches = branch_values(model);
     let length_scale = LengthScale::of(&model.arena, &model.lengths());
     let geometry = crate::geometry::checks(model);
+    let markers = crate::markers::values(model);
     Kinematics {
         phi,
         jacobian,
@@ -155,6 +158,7 @@ pub fn derive(model: &mut Model) -> Kinematics {
         branches,
         length_scale,
         geometry,
+        markers,
     }
 }
 
@@ -270,11 +274,7 @@ fn equations_with(model: &mut Model, poses: &[Option<[Id; 3]>]) -> Vec<Id> {
                 phi.push(f.arena.sub(ra[1], rb[1]));
             }
             ConstraintKind::Prismatic { a, b, axis } => {
-                // Normal n = A_a R u (R a quarter turn): b's point has no offset across the axis.
-                let neg_uy = f.arena.neg(axis[1]);
-                let normal = f.rotate(a.body, [neg_uy, axis[0]]);
-                let offset = f.separation(a, b);
-                phi.push(f.dot(normal, offset));
+                phi.push(f.normal_offset(a, b, axis));
                 // No relative rotation, written linearly (θ_b − θ_a) rather than as the seed's
                 // sin(θ_b − θ_a): same solution set near the assembly, constant Jacobian entries,
                 // no trigonometry, and no spurious root at a half turn.
@@ -286,6 +286,42 @@ fn equations_with(model: &mut Model, poses: &[Option<[Id; 3]>]) -> Vec<Id> {
                 let squared = f.dot(d, d);
                 let l2 = f.arena.powi(length, 2);
                 phi.push(f.arena.sub(squared, l2));
+            }
+            // The pin has no offset across the slot: the prismatic joint's normal equation alone.
+            ConstraintKind::Slot { a, b, axis } => phi.push(f.normal_offset(a, b, axis)),
+            ConstraintKind::Weld { a, b, angle } => {
+                let (ra, rb) = (f.world_point(a), f.world_point(b));
+                phi.push(f.arena.sub(ra[0], rb[0]));
+                phi.push(f.arena.sub(ra[1], rb[1]));
+                let (tb, ta) = (f.pose(b.body, 2), f.pose(a.body, 2));
+                let relative = f.arena.sub(tb, ta);
+                phi.push(f.arena.sub(relative, angle));
+            }
+            ConstraintKind::Gear {
+                a,
+                b,
+                carrier,
+                ratio,
+                phase,
+            } => {
+                let [ta, tb] = [a, b].map(|body| f.relative_angle(body, carrier));
+                let scaled = f.arena.mul(ratio, ta);
+                let turned = f.arena.sub(tb, scaled);
+                phi.push(f.arena.sub(turned, phase));
+            }
+            ConstraintKind::Rack {
+                a,
+                b,
+                axis,
+                pinion,
+                ratio,
+                phase,
+            } => {
+                let travel = f.travel(a, b, axis);
+                let turn = f.relative_angle(pinion, Some(a.body));
+                let rolled = f.arena.mul(ratio, turn);
+                let offset = f.arena.sub(travel, rolled);
+                phi.push(f.arena.sub(offset, phase));
             }
             ConstraintKind::Driver { driven, value } => {
                 let quantity = f.driven_quantity(driven);
@@ -354,6 +390,34 @@ impl Frames<'_> {
         self.arena.add(x, y)
     }
 
+    /// b's point's offset from the line through a's point along a-fixed unit `axis`, along the
+    /// normal n = A_a R u (R a quarter turn anticlockwise).
+    fn normal_offset(&mut self, a: Point, b: Point, axis: [Id; 2]) -> Id {
+        let neg_uy = self.arena.neg(axis[1]);
+        let normal = self.rotate(a.body, [neg_uy, axis[0]]);
+        let offset = self.separation(a, b);
+        self.dot(normal, offset)
+    }
+
+    /// b's point's travel along the line through a's point along a-fixed unit `axis`.
+    fn travel(&mut self, a: Point, b: Point, axis: [Id; 2]) -> Id {
+        let u = self.rotate(a.body, axis);
+        let d = self.separation(a, b);
+        self.dot(u, d)
+    }
+
+    /// θ_body − θ_reference (θ_body alone without a reference).
+    fn relative_angle(&mut self, body: usize, reference: Option<usize>) -> Id {
+        let angle = self.pose(body, 2);
+        match reference {
+            Some(reference) => {
+                let base = self.pose(reference, 2);
+                self.arena.sub(angle, base)
+            }
+            None => angle,
+        }
+    }
+
     fn driven_quantity(&mut self, driven: Driven) -> Id {
         match driven {
             Driven::Angle(body) => self.pose(body, 2),
@@ -363,10 +427,11 @@ impl Frames<'_> {
             }
             Driven::X(p) => self.world_point(p)[0],
             Driven::Y(p) => self.world_point(p)[1],
-            Driven::Travel { a, b, axis } => {
-                let u = self.rotate(a.body, axis);
+            Driven::Travel { a, b, axis } => self.travel(a, b, axis),
+            Driven::Distance(a, b) => {
                 let d = self.separation(a, b);
-                self.dot(u, d)
+                let squared = self.dot(d, d);
+                self.arena.call(crate::expr::Func::Sqrt, squared)
             }
         }
     }

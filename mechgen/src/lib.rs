@@ -27,11 +27,13 @@ pub mod graph;
 pub mod interpret;
 pub mod kinematics;
 pub mod limits;
+pub mod markers;
 pub mod model;
 pub mod parse;
 pub mod reactions;
 pub mod resolution;
 pub mod spec;
+pub mod spline;
 pub mod stats;
 pub mod structure;
 

@@ -31,6 +31,8 @@ pub struct Model {
     pub gravity: [Id; 2],
     /// Applied loads in declaration order.
     pub loads: Vec<Load>,
+    /// Markers in declaration order.
+    pub markers: Vec<Marker>,
     /// What the scene asked to compute.
     pub outputs: Outputs,
 }
@@ -106,6 +108,48 @@ pub struct MassProperties {
     pub inertia: Id,
     /// The centre of mass in the body's frame.
     pub centre: [Id; 2],
+}
+
+/// A named output computed from the solved state.
+#[derive(Clone)]
+pub struct Marker {
+    /// Name as declared.
+    pub name: String,
+    /// Doc comments.
+    pub docs: Vec<Attribute>,
+    /// What it tracks.
+    pub kind: MarkerKind,
+}
+
+/// What a marker tracks.
+#[derive(Clone, Copy)]
+pub enum MarkerKind {
+    /// A body-fixed point's world position.
+    Point(Point),
+    /// θ_b − θ_a.
+    Angle(usize, usize),
+}
+
+impl MarkerKind {
+    /// Suffixes of the marker's values at each level of derivatives, in layout order: a point
+    /// `x`, `y` (then `x_dot`, `y_dot`, then `x_ddot`, `y_ddot`), a sensor `angle` (then
+    /// `angle_dot`, `angle_ddot`).
+    pub fn suffixes(&self, outputs: Outputs) -> Vec<&'static str> {
+        let levels: [&[&str]; 3] = match self {
+            MarkerKind::Point(_) => [&["x", "y"], &["x_dot", "y_dot"], &["x_ddot", "y_ddot"]],
+            MarkerKind::Angle(..) => [&["angle"], &["angle_dot"], &["angle_ddot"]],
+        };
+        let count = match outputs {
+            Outputs::Positions => 1,
+            Outputs::Velocities => 2,
+            Outputs::Accelerations | Outputs::Forces => 3,
+        };
+        levels
+            .iter()
+            .take(count)
+            .flat_map(|l| l.iter().copied())
+            .collect()
+    }
 }
 
 /// A named applied load.
@@ -204,6 +248,54 @@ pub enum ConstraintKind {
         /// The distance.
         length: Id,
     },
+    /// `b`'s point (a pin) on the line through `a`'s point along `a`-fixed unit `axis`; the pin
+    /// may turn (1 equation).
+    Slot {
+        /// Point on the slotted body.
+        a: Point,
+        /// The pin.
+        b: Point,
+        /// Unit axis in the slotted body's frame.
+        axis: [Id; 2],
+    },
+    /// The points coincide and `θ_b − θ_a = angle` (3 equations).
+    Weld {
+        /// Point on the first body.
+        a: Point,
+        /// Point on the second body.
+        b: Point,
+        /// The relative angle.
+        angle: Id,
+    },
+    /// `θ_b − θ_c = ratio (θ_a − θ_c) + phase`, c the carrier (none: the world).
+    Gear {
+        /// The driving gear.
+        a: usize,
+        /// The driven gear.
+        b: usize,
+        /// The carrier, if any.
+        carrier: Option<usize>,
+        /// The ratio.
+        ratio: Id,
+        /// The phase.
+        phase: Id,
+    },
+    /// The travel of a prismatic joint (`a`'s point, `b`'s point, `a`-fixed unit `axis`) is
+    /// `ratio (θ_pinion − θ_a) + phase`.
+    Rack {
+        /// The guide's point.
+        a: Point,
+        /// The rack's point.
+        b: Point,
+        /// Unit axis in the guide's frame.
+        axis: [Id; 2],
+        /// The pinion body.
+        pinion: usize,
+        /// Travel per radian.
+        ratio: Id,
+        /// Travel at zero pinion angle.
+        phase: Id,
+    },
     /// A driven quantity equals `value(t)`.
     Driver {
         /// The driven quantity.
@@ -265,7 +357,8 @@ pub enum Driven {
     X(Point),
     /// Global y of a point.
     Y(Point),
-    /// Travel of a prismatic joint's slider along its unit axis.
+    /// Travel of a point along a line of another body (a prismatic joint's slider, or any
+    /// line: the `slide` driver), along its unit axis.
     Travel {
         /// Point on the guiding body.
         a: Point,
@@ -274,6 +367,8 @@ pub enum Driven {
         /// Unit axis in the guiding body's frame.
         axis: [Id; 2],
     },
+    /// The distance between two points (a linear actuator).
+    Distance(Point, Point),
 }
 
 impl ConstraintKind {
@@ -283,7 +378,12 @@ impl ConstraintKind {
             ConstraintKind::Ground { .. } => &["x", "y", "theta"],
             ConstraintKind::Revolute { .. } => &["x", "y"],
             ConstraintKind::Prismatic { .. } => &["normal", "angle"],
-            ConstraintKind::Distance { .. } | ConstraintKind::Driver { .. } => &[""],
+            ConstraintKind::Weld { .. } => &["x", "y", "angle"],
+            ConstraintKind::Distance { .. }
+            | ConstraintKind::Slot { .. }
+            | ConstraintKind::Gear { .. }
+            | ConstraintKind::Rack { .. }
+            | ConstraintKind::Driver { .. } => &[""],
         }
     }
 
@@ -297,9 +397,14 @@ impl ConstraintKind {
             ConstraintKind::Revolute { .. } => &[Unit::Length, Unit::Length],
             ConstraintKind::Prismatic { .. } => &[Unit::Length, Unit::Angle],
             ConstraintKind::Distance { .. } => &[Unit::Area],
+            ConstraintKind::Slot { .. } | ConstraintKind::Rack { .. } => &[Unit::Length],
+            ConstraintKind::Weld { .. } => &[Unit::Length, Unit::Length, Unit::Angle],
+            ConstraintKind::Gear { .. } => &[Unit::Angle],
             ConstraintKind::Driver { driven, .. } => match driven {
                 Driven::Angle(_) | Driven::RelativeAngle(..) => &[Unit::Angle],
-                Driven::X(_) | Driven::Y(_) | Driven::Travel { .. } => &[Unit::Length],
+                Driven::X(_) | Driven::Y(_) | Driven::Travel { .. } | Driven::Distance(..) => {
+                    &[Unit::Length]
+                }
             },
         }
     }
@@ -314,22 +419,29 @@ impl ConstraintKind {
             ConstraintKind::Revolute { .. } => &["fx", "fy"],
             ConstraintKind::Prismatic { .. } => &["normal", "torque"],
             ConstraintKind::Distance { .. } => &["tension"],
+            ConstraintKind::Slot { .. } => &["normal"],
+            ConstraintKind::Weld { .. } => &["fx", "fy", "torque"],
+            ConstraintKind::Gear { .. } => &["torque"],
+            ConstraintKind::Rack { .. } => &["force"],
             ConstraintKind::Driver { .. } => &["effort"],
         }
     }
 
-    /// The body-fixed points this constraint places (none for ground equations and angle
-    /// drivers).
+    /// The body-fixed points this constraint places (none for ground equations, gears and
+    /// angle drivers).
     pub fn points(&self) -> Vec<Point> {
         match *self {
-            ConstraintKind::Ground { .. } => Vec::new(),
+            ConstraintKind::Ground { .. } | ConstraintKind::Gear { .. } => Vec::new(),
             ConstraintKind::Revolute { a, b }
             | ConstraintKind::Prismatic { a, b, .. }
-            | ConstraintKind::Distance { a, b, .. } => vec![a, b],
+            | ConstraintKind::Distance { a, b, .. }
+            | ConstraintKind::Slot { a, b, .. }
+            | ConstraintKind::Weld { a, b, .. }
+            | ConstraintKind::Rack { a, b, .. } => vec![a, b],
             ConstraintKind::Driver { driven, .. } => match driven {
                 Driven::Angle(_) | Driven::RelativeAngle(..) => Vec::new(),
                 Driven::X(p) | Driven::Y(p) => vec![p],
-                Driven::Travel { a, b, .. } => vec![a, b],
+                Driven::Travel { a, b, .. } | Driven::Distance(a, b) => vec![a, b],
             },
         }
     }
@@ -381,6 +493,19 @@ impl Model {
                     .reaction_suffixes()
                     .iter()
                     .map(move |s| format!("{}.{s}", c.name))
+            })
+            .collect()
+    }
+
+    /// Marker value names in layout order (`tip.x`, `tip.y`, `tip.x_dot`, …, `swing.angle`, …).
+    pub fn marker_names(&self) -> Vec<String> {
+        self.markers
+            .iter()
+            .flat_map(|m| {
+                m.kind
+                    .suffixes(self.outputs)
+                    .into_iter()
+                    .map(move |s| format!("{}.{s}", m.name))
             })
             .collect()
     }

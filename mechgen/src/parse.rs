@@ -11,7 +11,8 @@ use syn::{Attribute, Ident, LitFloat, LitInt, Token, Visibility, braced, parenth
 
 use crate::spec::{
     BinOp, BodyDecl, BranchDecl, DriverDecl, DriverKind, Expr, ExprKind, GravityDecl, JointDecl,
-    JointKind, LoadDecl, LoadKind, MassDecl, ParamDecl, PointRef, Product, Sign, Spec,
+    JointKind, LoadDecl, LoadKind, MarkerDecl, MarkerKind, MassDecl, ParamDecl, PointRef, Product,
+    Sign, Spec,
 };
 
 mod kw {
@@ -32,6 +33,7 @@ mod kw {
     syn::custom_keyword!(center);
     syn::custom_keyword!(gravity);
     syn::custom_keyword!(load);
+    syn::custom_keyword!(marker);
     syn::custom_keyword!(stiffness);
     syn::custom_keyword!(length);
     syn::custom_keyword!(damping);
@@ -79,6 +81,7 @@ impl Parse for Spec {
             branches: Vec::new(),
             gravity: None,
             loads: Vec::new(),
+            markers: Vec::new(),
             outputs: None,
         };
         while !content.is_empty() {
@@ -203,6 +206,39 @@ fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> {
             span: keyword.span,
             value,
         });
+    } else if look.peek(kw::marker) {
+        input.parse::<kw::marker>()?;
+        let name = input.parse()?;
+        input.parse::<Token![:]>()?;
+        // `angle(a, b)` is a sensor; anything else a point (a body named `angle` still works
+        // as `angle @ (x, y)` or `angle` alone).
+        let kind = if input.peek(Ident) && input.peek2(syn::token::Paren) {
+            let kind: Ident = input.parse()?;
+            if kind != "angle" {
+                return Err(syn::Error::new(
+                    kind.span(),
+                    format!(
+                        "unknown marker `{kind}(…)`; a marker tracks a point, `marker NAME: \
+                         body @ (x, y);`, or an angle between two bodies, `marker NAME: \
+                         angle(a, b);`"
+                    ),
+                ));
+            }
+            let args;
+            parenthesized!(args in input);
+            let a = args.parse()?;
+            args.parse::<Token![,]>()?;
+            let b = args.parse()?;
+            if !args.is_empty() {
+                return Err(
+                    args.error("unexpected argument: `angle` takes two bodies: `angle(a, b)`")
+                );
+            }
+            MarkerKind::Angle(a, b)
+        } else {
+            MarkerKind::Point(input.parse()?)
+        };
+        spec.markers.push(MarkerDecl { docs, name, kind });
     } else if look.peek(kw::load) {
         input.parse::<kw::load>()?;
         let name = input.parse()?;
@@ -291,29 +327,68 @@ fn vector(input: ParseStream) -> syn::Result<[PointRef; 2]> {
     Ok([from, to])
 }
 
+/// The joint kinds and how each is written, for error messages.
+const JOINT_KINDS: &str = "`revolute(a @ (x, y), b @ (x, y))`, `prismatic(a, b, along (ux, uy))`, \
+     `distance(a, b, length)`, `slot(a @ (x, y), b @ (x, y), along (ux, uy))`, \
+     `weld(a @ (x, y), b @ (x, y))`, `gear(a, b, ratio k, carrier c)` or \
+     `rack(prismatic_joint, pinion, ratio r)`";
+
 fn joint_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, JointKind)> {
     let kind: Ident = input.parse()?;
     let args;
     parenthesized!(args in input);
-    let a = args.parse()?;
+    let a: PointRef = args.parse()?;
     args.parse::<Token![,]>()?;
-    let b = args.parse()?;
-    let joint = match kind.to_string().as_str() {
-        "revolute" => JointKind::Revolute { a, b },
+    let b: PointRef = args.parse()?;
+    let name = kind.to_string();
+    let usage = match name.as_str() {
+        "revolute" => "`revolute` joins two points: `revolute(a @ (x, y), b @ (x, y))`",
         "prismatic" => {
+            "`prismatic` takes two bodies and an axis: `prismatic(a, b, along (ux, uy))`"
+        }
+        "distance" => "`distance` takes two points and a length: `distance(a @ (x, y), b, length)`",
+        "slot" => {
+            "`slot` takes a point on the slot, the pin and the slot's direction: \
+             `slot(a @ (x, y), b @ (x, y), along (ux, uy))`"
+        }
+        "weld" => {
+            "`weld` takes two points and optionally their relative angle: \
+             `weld(a @ (x, y), b @ (x, y), angle 30deg)`"
+        }
+        "gear" => {
+            "`gear` takes two bodies and their ratio, optionally a carrier and a phase: \
+             `gear(sun, planet, ratio -2, carrier arm, phase 0.1)`"
+        }
+        "rack" => {
+            "`rack` takes a prismatic joint, the pinion and the travel per radian: \
+             `rack(slide, pinion, ratio 20, phase 0)`"
+        }
+        other => {
+            return Err(syn::Error::new(
+                kind.span(),
+                format!("unknown joint kind `{other}`; expected {JOINT_KINDS}"),
+            ));
+        }
+    };
+    let joint = match name.as_str() {
+        "revolute" => JointKind::Revolute { a, b },
+        "prismatic" | "slot" => {
             args.parse::<Token![,]>()?;
-            args.parse::<kw::along>().map_err(|e| {
-                syn::Error::new(
-                    e.span(),
-                    "expected `along (ux, uy)`: the axis in the first body's frame",
-                )
-            })?;
-            let (axis, axis_span) = tuple::<2>(&args, "(ux, uy)")?;
-            JointKind::Prismatic {
-                a,
-                b,
-                axis,
-                axis_span,
+            let (axis, axis_span) = along(&args)?;
+            if name == "slot" {
+                JointKind::Slot {
+                    a,
+                    b,
+                    axis,
+                    axis_span,
+                }
+            } else {
+                JointKind::Prismatic {
+                    a,
+                    b,
+                    axis,
+                    axis_span,
+                }
             }
         }
         "distance" => {
@@ -321,31 +396,114 @@ fn joint_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, JointKind)>
             let length = args.parse()?;
             JointKind::Distance { a, b, length }
         }
-        other => {
-            return Err(syn::Error::new(
-                kind.span(),
-                format!(
-                    "unknown joint kind `{other}`; expected `revolute(a @ (x, y), b @ (x, y))`, \
-                     `prismatic(a, b, along (ux, uy))` or `distance(a, b, length)`"
-                ),
-            ));
+        "weld" => {
+            let mut options = Keywords::parse(&args, &["angle"], usage)?;
+            JointKind::Weld {
+                a,
+                b,
+                angle: options.take("angle"),
+            }
+        }
+        "gear" => {
+            let (a, b) = (whole_body(a, usage)?, whole_body(b, usage)?);
+            let mut options = Keywords::parse(&args, &["ratio", "carrier", "phase"], usage)?;
+            let ratio = options.required("ratio", kind.span(), usage)?;
+            let carrier = match options.take("carrier") {
+                Some(Expr {
+                    kind: ExprKind::Name(body),
+                    ..
+                }) => Some(body),
+                Some(other) => return Err(syn::Error::new(other.span, usage)),
+                None => None,
+            };
+            JointKind::Gear {
+                a,
+                b,
+                ratio,
+                carrier,
+                phase: options.take("phase"),
+            }
+        }
+        _ => {
+            let (joint, pinion) = (whole_body(a, usage)?, whole_body(b, usage)?);
+            let mut options = Keywords::parse(&args, &["ratio", "phase"], usage)?;
+            JointKind::Rack {
+                joint,
+                pinion,
+                ratio: options.required("ratio", kind.span(), usage)?,
+                phase: options.take("phase"),
+            }
         }
     };
     if !args.is_empty() {
-        let advice = match joint {
-            JointKind::Revolute { .. } => {
-                "`revolute` joins two points: `revolute(a @ (x, y), b @ (x, y))`"
-            }
-            JointKind::Prismatic { .. } => {
-                "`prismatic` takes two bodies and an axis: `prismatic(a, b, along (ux, uy))`"
-            }
-            JointKind::Distance { .. } => {
-                "`distance` takes two points and a length: `distance(a @ (x, y), b, length)`"
-            }
-        };
-        return Err(args.error(format!("unexpected argument: {advice}")));
+        return Err(args.error(format!("unexpected argument: {usage}")));
     }
     Ok((kind.span(), joint))
+}
+
+/// `along (ux, uy)`: an axis in the first body's frame.
+fn along(input: ParseStream) -> syn::Result<([Expr; 2], proc_macro2::Span)> {
+    input.parse::<kw::along>().map_err(|e| {
+        syn::Error::new(
+            e.span(),
+            "expected `along (ux, uy)`: the axis in the first body's frame",
+        )
+    })?;
+    tuple::<2>(input, "(ux, uy)")
+}
+
+/// A body named alone (`gear(sun, planet, …)`), not a point of it.
+fn whole_body(point: PointRef, usage: &str) -> syn::Result<Ident> {
+    match point.local {
+        None => Ok(point.body),
+        Some(_) => Err(syn::Error::new(
+            point.body.span(),
+            format!("name the body alone, without `@ (x, y)`: {usage}"),
+        )),
+    }
+}
+
+/// Keyword arguments after a joint's points, `, ratio -2, carrier arm`, each at most once, in
+/// any order.
+struct Keywords(Vec<(Ident, Expr)>);
+
+impl Keywords {
+    fn parse(input: ParseStream, allowed: &[&str], usage: &str) -> syn::Result<Self> {
+        let mut found: Vec<(Ident, Expr)> = Vec::new();
+        while !input.is_empty() {
+            input.parse::<Token![,]>()?;
+            let keyword: Ident = input.parse()?;
+            if !allowed.iter().any(|a| keyword == a) {
+                return Err(syn::Error::new(
+                    keyword.span(),
+                    format!("unexpected `{keyword}`: {usage}"),
+                ));
+            }
+            if found.iter().any(|(k, _)| *k == keyword) {
+                return Err(syn::Error::new(
+                    keyword.span(),
+                    format!("`{keyword}` is given twice; keep one"),
+                ));
+            }
+            found.push((keyword, input.parse()?));
+        }
+        Ok(Keywords(found))
+    }
+
+    fn take(&mut self, keyword: &str) -> Option<Expr> {
+        let k = self.0.iter().position(|(k, _)| k == keyword)?;
+        Some(self.0.remove(k).1)
+    }
+
+    fn required(
+        &mut self,
+        keyword: &str,
+        span: proc_macro2::Span,
+        usage: &str,
+    ) -> syn::Result<Expr> {
+        self.take(keyword)
+            .ok_or_else(|| syn::Error::new(span, format!("missing `{keyword}`: {usage}")))
+    }
 }
 
 fn driver_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, DriverKind)> {
@@ -362,13 +520,32 @@ fn driver_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, DriverKind
         "x" => DriverKind::X(args.parse()?),
         "y" => DriverKind::Y(args.parse()?),
         "travel" => DriverKind::Travel(args.parse()?),
+        "distance" => {
+            let a = args.parse()?;
+            args.parse::<Token![,]>()?;
+            DriverKind::Distance(a, args.parse()?)
+        }
+        "slide" => {
+            let a = args.parse()?;
+            args.parse::<Token![,]>()?;
+            let b = args.parse()?;
+            args.parse::<Token![,]>()?;
+            let (axis, axis_span) = along(&args)?;
+            DriverKind::Slide {
+                a,
+                b,
+                axis,
+                axis_span,
+            }
+        }
         other => {
             return Err(syn::Error::new(
                 kind.span(),
                 format!(
                     "unknown driver kind `{other}`; expected `angle(body)`, \
-                     `relative_angle(a, b)`, `x(body @ (x, y))`, `y(body @ (x, y))` or \
-                     `travel(prismatic_joint)`"
+                     `relative_angle(a, b)`, `x(body @ (x, y))`, `y(body @ (x, y))`, \
+                     `travel(prismatic_joint)`, `distance(a @ (x, y), b @ (x, y))` or \
+                     `slide(a @ (x, y), b @ (x, y), along (ux, uy))`"
                 ),
             ));
         }
@@ -387,6 +564,12 @@ fn driver_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, DriverKind
             }
             DriverKind::RelativeAngle(..) => {
                 "`relative_angle` takes two bodies: `relative_angle(a, b)`"
+            }
+            DriverKind::Distance(..) => {
+                "`distance` takes two points: `distance(a @ (x, y), b @ (x, y))`"
+            }
+            DriverKind::Slide { .. } => {
+                "`slide` takes two points and an axis: `slide(a @ (x, y), b, along (ux, uy))`"
             }
         };
         return Err(args.error(format!("unexpected argument: {advice}")));
@@ -621,18 +804,36 @@ fn power(input: ParseStream) -> syn::Result<Expr> {
     }
     let span = input.span();
     input.parse::<Token![^]>()?;
-    let negative = input.parse::<Option<Token![-]>>()?.is_some();
-    let exponent: LitInt = input.parse().map_err(|e| {
+    // An integer literal (optionally negative) is an integer power, exact for any base;
+    // anything else is a real power.
+    let fork = input.fork();
+    let negative = fork.parse::<Option<Token![-]>>()?.is_some();
+    if fork.peek(LitInt) && !fork.peek2(Token![.]) {
+        input.parse::<Option<Token![-]>>()?;
+        let exponent: LitInt = input.parse()?;
+        if !exponent.suffix().is_empty() {
+            return Err(syn::Error::new(
+                exponent.span(),
+                "an exponent takes no suffix: write `x^2`",
+            ));
+        }
+        let magnitude: i32 = exponent.base10_parse()?;
+        let n = if negative { -magnitude } else { magnitude };
+        return Ok(Expr {
+            span,
+            kind: ExprKind::Pow(Box::new(base), n),
+        });
+    }
+    let exponent = unary(input).map_err(|e| {
         syn::Error::new(
             e.span(),
-            "`^` takes an integer exponent, such as `t^2` or `x^-1`",
+            "`^` takes an exponent: an integer (`t^2`, `x^-1`), a number (`x^1.5`), a \
+             parameter or a parenthesised expression",
         )
     })?;
-    let magnitude: i32 = exponent.base10_parse()?;
-    let n = if negative { -magnitude } else { magnitude };
     Ok(Expr {
         span,
-        kind: ExprKind::Pow(Box::new(base), n),
+        kind: ExprKind::RealPow(Box::new(base), Box::new(exponent)),
     })
 }
 
@@ -640,12 +841,27 @@ fn atom(input: ParseStream) -> syn::Result<Expr> {
     let span = input.span();
     if input.peek(syn::token::Paren) {
         let content;
-        parenthesized!(content in input);
-        let inner: Expr = content.parse()?;
-        if !content.is_empty() {
+        let paren = parenthesized!(content in input);
+        let first: Expr = content.parse()?;
+        if content.is_empty() {
+            return Ok(first);
+        }
+        if !content.peek(Token![,]) {
             return Err(content.error("expected `)` after the expression"));
         }
-        return Ok(inner);
+        // `(a, b, …)`: a spline point.
+        let mut items = vec![first];
+        while !content.is_empty() {
+            content.parse::<Token![,]>()?;
+            if content.is_empty() {
+                break;
+            }
+            items.push(content.parse()?);
+        }
+        return Ok(Expr {
+            span: paren.span.join(),
+            kind: ExprKind::Tuple(items),
+        });
     }
     if input.peek(LitFloat) {
         let lit: LitFloat = input.parse()?;
@@ -660,21 +876,10 @@ fn atom(input: ParseStream) -> syn::Result<Expr> {
         if input.peek(syn::token::Paren) {
             let content;
             parenthesized!(content in input);
-            let arg: Expr = content.parse()?;
-            if !content.is_empty() {
-                let supported: Vec<String> = crate::expr::Func::ALL
-                    .iter()
-                    .map(|f| format!("`{}`", f.name()))
-                    .collect();
-                return Err(content.error(format!(
-                    "`{name}` with more than one argument is not supported: the functions are \
-                     {}, each of one argument",
-                    supported.join(", ")
-                )));
-            }
+            let args = syn::punctuated::Punctuated::<Expr, Token![,]>::parse_terminated(&content)?;
             return Ok(Expr {
                 span,
-                kind: ExprKind::Call(name, Box::new(arg)),
+                kind: ExprKind::Call(name, args.into_iter().collect()),
             });
         }
         return Ok(Expr {
@@ -685,16 +890,25 @@ fn atom(input: ParseStream) -> syn::Result<Expr> {
     Err(input.error("expected a number, `t`, a parameter, a function call or `(`"))
 }
 
+/// A numeric literal; the suffix `deg` turns degrees into radians (`30deg`).
 fn number(digits: &str, suffix: &str, span: proc_macro2::Span) -> syn::Result<Expr> {
-    if !suffix.is_empty() {
-        return Err(syn::Error::new(
-            span,
-            format!("remove the `{suffix}` suffix: every number is an f64"),
-        ));
-    }
+    let scale = match suffix {
+        "" => 1.0,
+        "deg" => core::f64::consts::PI / 180.0,
+        _ => {
+            return Err(syn::Error::new(
+                span,
+                format!(
+                    "remove the `{suffix}` suffix: every number is an f64 (only `deg`, for \
+                     degrees, is accepted: `30deg`)"
+                ),
+            ));
+        }
+    };
     let value: f64 = digits
         .parse()
         .map_err(|_| syn::Error::new(span, "not a valid number"))?;
+    let value = value * scale;
     if !value.is_finite() {
         return Err(syn::Error::new(span, "number is too large for an f64"));
     }
@@ -723,7 +937,15 @@ mod tests {
                 format!("({} {op} {})", show(a), show(b))
             }
             ExprKind::Pow(a, n) => format!("({}^{n})", show(a)),
-            ExprKind::Call(f, a) => format!("{f}({})", show(a)),
+            ExprKind::RealPow(a, b) => format!("({}^{})", show(a), show(b)),
+            ExprKind::Call(f, args) => {
+                let args: Vec<String> = args.iter().map(show).collect();
+                format!("{f}({})", args.join(", "))
+            }
+            ExprKind::Tuple(items) => {
+                let items: Vec<String> = items.iter().map(show).collect();
+                format!("({})", items.join(", "))
+            }
         }
     }
 
@@ -741,6 +963,15 @@ mod tests {
         assert_eq!(expr("0.5 * sin(2000 * t)"), "(0.5 * sin((2000 * t)))");
         assert_eq!(expr("x^-1"), "(x^-1)");
         assert_eq!(expr("1e-6"), "0.000001");
+        assert_eq!(expr("x^1.5"), "(x^1.5)");
+        assert_eq!(expr("x^p * 2"), "((x^p) * 2)");
+        assert_eq!(expr("x^-(a + b)"), "(x^(-(a + b)))");
+        assert_eq!(expr("atan2(y, x) + 1"), "(atan2(y, x) + 1)");
+        assert_eq!(
+            expr("spline(t, (0, 1), (2, 3))"),
+            "spline(t, (0, 1), (2, 3))"
+        );
+        assert_eq!(expr("180deg"), format!("{}", core::f64::consts::PI));
     }
 
     #[test]
@@ -777,7 +1008,8 @@ mod tests {
         assert!(err("mechanism M { body b at (0, 0, 0); }").contains("near (x, y, angle)"));
         assert!(err("mechanism M { body b near (0, 0); }").contains("expected 3"));
         assert!(err("mechanism M { param p = 1f32; }").contains("suffix"));
-        assert!(err("mechanism M { param p = t^x; }").contains("integer exponent"));
+        assert!(err("mechanism M { param p = t^; }").contains("takes an exponent"));
+        assert!(err("mechanism M { param p = 3kg; }").contains("`deg`"));
         assert!(err("#[derive(Debug)] mechanism M {}").contains("only doc comments"));
         assert!(err("struct M {}").contains("mechanism Name"));
         assert!(err("mechanism M { branch b: cross(a -> b, c -> d) >= 0; }").contains("strictly"));

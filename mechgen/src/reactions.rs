@@ -243,14 +243,26 @@ fn reported(model: &mut Model, kin: &Kinematics) -> Vec<Id> {
             ConstraintKind::Ground { body, .. } => {
                 reactions.extend((0..3).map(|k| loads[3 * body + k]));
             }
-            ConstraintKind::Revolute { .. } | ConstraintKind::Driver { .. } => {
+            // The force on the first body: −λ; and a driver's effort, −λ along its coordinate.
+            ConstraintKind::Revolute { .. }
+            | ConstraintKind::Gear { .. }
+            | ConstraintKind::Rack { .. }
+            | ConstraintKind::Driver { .. } => {
                 for k in 0..kind.equation_suffixes().len() {
                     let l = lambda(arena, k);
                     reactions.push(arena.neg(l));
                 }
             }
-            ConstraintKind::Prismatic { .. } => {
-                reactions.extend((0..2).map(|k| lambda(arena, k)));
+            ConstraintKind::Prismatic { .. } | ConstraintKind::Slot { .. } => {
+                reactions.extend((0..kind.equation_suffixes().len()).map(|k| lambda(arena, k)));
+            }
+            // The force on the first body at the point, −λ, and its torque, +λ (θ_b − θ_a).
+            ConstraintKind::Weld { .. } => {
+                for k in 0..2 {
+                    let l = lambda(arena, k);
+                    reactions.push(arena.neg(l));
+                }
+                reactions.push(lambda(arena, 2));
             }
             ConstraintKind::Distance { length, .. } => {
                 // Φ = |d|² − L²: the force on the first body is 2 λ d, along d with length L.

@@ -28,6 +28,8 @@ pub struct Spec {
     pub gravity: Option<GravityDecl>,
     /// Applied loads (forces, torques, springs) in declaration order.
     pub loads: Vec<LoadDecl>,
+    /// Markers (tracked points, angle sensors) in declaration order.
+    pub markers: Vec<MarkerDecl>,
     /// The `outputs …;` statement, if any: the listed names with their spans.
     pub outputs: Option<Vec<proc_macro2::Ident>>,
 }
@@ -76,6 +78,27 @@ pub struct MassDecl {
     pub centre: Option<([Expr; 2], Span)>,
 }
 
+/// `marker NAME: body @ (x, y);` or `marker NAME: angle(a, b);`: an output computed from the
+/// solved state, with its rates.
+#[derive(Clone)]
+pub struct MarkerDecl {
+    /// Doc comments, carried onto the generated accessor.
+    pub docs: Vec<Attribute>,
+    /// Name of the marker (its accessor and CSV columns).
+    pub name: Ident,
+    /// What it tracks.
+    pub kind: MarkerKind,
+}
+
+/// What a marker tracks.
+#[derive(Clone)]
+pub enum MarkerKind {
+    /// A body-fixed point's world position.
+    Point(PointRef),
+    /// `angle(a, b)`: θ_b − θ_a.
+    Angle(Ident, Ident),
+}
+
 /// `gravity (gx, gy);`: the acceleration of gravity in world axes.
 #[derive(Clone)]
 pub struct GravityDecl {
@@ -99,6 +122,9 @@ pub struct LoadDecl {
 }
 
 /// The applied loads of the spec language.
+// A scene holds a handful of loads, parsed once at compile time: boxing the spring would only
+// add indirection.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone)]
 pub enum LoadKind {
     /// `force(point) = (fx, fy)` in world axes, or `local_force(point) = (fx, fy)` in the
@@ -188,6 +214,83 @@ pub enum JointKind {
         /// The distance.
         length: Expr,
     },
+    /// `slot(a @ p_a, b @ p_b, along (ux, uy))`: `b`'s point (a pin) stays on the line through
+    /// `a`'s point along the `a`-fixed axis; the pin may turn (1 equation).
+    Slot {
+        /// Point on the slotted body, on the slot's line.
+        a: PointRef,
+        /// The pin, on the other body.
+        b: PointRef,
+        /// The slot's direction in the first body's frame.
+        axis: [Expr; 2],
+        /// Span of the axis, for diagnostics.
+        axis_span: Span,
+    },
+    /// `weld(a @ p_a, b @ p_b[, angle θ])`: the points coincide and `θ_b − θ_a = θ`
+    /// (default 0): the two bodies move as one (3 equations).
+    Weld {
+        /// Point on the first body.
+        a: PointRef,
+        /// Point on the second body.
+        b: PointRef,
+        /// The relative angle, if given.
+        angle: Option<Expr>,
+    },
+    /// `gear(a, b, ratio k[, carrier c][, phase φ])`: `θ_b − θ_c = k (θ_a − θ_c) + φ`, the
+    /// rotations relative to the carrier in a fixed ratio (1 equation); without a carrier,
+    /// relative to the world.
+    Gear {
+        /// The driving gear.
+        a: Ident,
+        /// The driven gear.
+        b: Ident,
+        /// The ratio k (negative for an external pair: −z_a/z_b; positive for internal).
+        ratio: Expr,
+        /// The carrier both gears turn on, if any.
+        carrier: Option<Ident>,
+        /// The phase φ (default 0).
+        phase: Option<Expr>,
+    },
+    /// `rack(joint, pinion, ratio r[, phase s])`: the travel of prismatic joint `joint` is
+    /// `r (θ_pinion − θ_guide) + s`, the guide being the joint's first body (1 equation).
+    Rack {
+        /// The prismatic joint the rack slides in.
+        joint: Ident,
+        /// The pinion.
+        pinion: Ident,
+        /// Travel per radian of the pinion (its pitch radius, signed).
+        ratio: Expr,
+        /// The travel at zero pinion angle (default 0).
+        phase: Option<Expr>,
+    },
+}
+
+impl JointKind {
+    /// Equations of the joint (its share of the Gruebler count).
+    pub fn equations(&self) -> usize {
+        match self {
+            JointKind::Revolute { .. } | JointKind::Prismatic { .. } => 2,
+            JointKind::Weld { .. } => 3,
+            JointKind::Distance { .. }
+            | JointKind::Slot { .. }
+            | JointKind::Gear { .. }
+            | JointKind::Rack { .. } => 1,
+        }
+    }
+
+    /// The bodies the joint names (for a rack, its pinion: the prismatic joint names the
+    /// others).
+    pub fn bodies(&self) -> Vec<&Ident> {
+        match self {
+            JointKind::Revolute { a, b }
+            | JointKind::Prismatic { a, b, .. }
+            | JointKind::Distance { a, b, .. }
+            | JointKind::Slot { a, b, .. }
+            | JointKind::Weld { a, b, .. } => vec![&a.body, &b.body],
+            JointKind::Gear { a, b, carrier, .. } => [a, b].into_iter().chain(carrier).collect(),
+            JointKind::Rack { pinion, .. } => vec![pinion],
+        }
+    }
 }
 
 /// `driver NAME: KIND(...) = f(t);`
@@ -218,6 +321,33 @@ pub enum DriverKind {
     Y(PointRef),
     /// `travel(joint)`: position of a prismatic joint's slider along its axis.
     Travel(Ident),
+    /// `distance(a @ p, b @ q)`: the distance between two points (a linear actuator).
+    Distance(PointRef, PointRef),
+    /// `slide(a @ p, b @ q, along (ux, uy))`: the travel of `b`'s point along the line through
+    /// `a`'s point along the `a`-fixed axis.
+    Slide {
+        /// Point on the guiding body.
+        a: PointRef,
+        /// Point on the sliding body.
+        b: PointRef,
+        /// The direction in the guiding body's frame.
+        axis: [Expr; 2],
+        /// Span of the axis, for diagnostics.
+        axis_span: Span,
+    },
+}
+
+impl DriverKind {
+    /// The bodies the driver moves (none named directly for `travel`).
+    pub fn bodies(&self) -> Vec<&Ident> {
+        match self {
+            DriverKind::Angle(b) => vec![b],
+            DriverKind::RelativeAngle(a, b) => vec![a, b],
+            DriverKind::X(p) | DriverKind::Y(p) => vec![&p.body],
+            DriverKind::Distance(a, b) | DriverKind::Slide { a, b, .. } => vec![&a.body, &b.body],
+            DriverKind::Travel(_) => Vec::new(),
+        }
+    }
 }
 
 /// `branch NAME: cross(p1 -> p2, p3 -> p4) > 0;` (or `dot(…)`, or `< 0`): a sign that tells the
@@ -292,8 +422,12 @@ pub enum ExprKind {
     Binary(BinOp, Box<Expr>, Box<Expr>),
     /// `a ^ n` with an integer literal n.
     Pow(Box<Expr>, i32),
-    /// `f(a)`
-    Call(Ident, Box<Expr>),
+    /// `a ^ b` with any other exponent (a real power: the base must be positive).
+    RealPow(Box<Expr>, Box<Expr>),
+    /// `f(a, …)`
+    Call(Ident, Vec<Expr>),
+    /// `(a, b, …)`: a point of a spline (`check` refuses it anywhere else).
+    Tuple(Vec<Expr>),
 }
 
 /// Binary operators.

@@ -25,6 +25,8 @@ pub struct OpCounts {
     pub div: usize,
     /// Negations.
     pub neg: usize,
+    /// Other calls: atan2, asin, acos, real powers, branch selections and spline lookups.
+    pub other: usize,
 }
 
 impl OpCounts {
@@ -52,7 +54,9 @@ impl OpCounts {
                     Func::Sin | Func::Cos | Func::Tan => c.trig += 1,
                     Func::Sqrt => c.sqrt += 1,
                     Func::Exp | Func::Ln => c.exp_ln += 1,
+                    Func::Asin | Func::Acos => c.other += 1,
                 },
+                Node::Call2(..) | Node::Select(..) | Node::Spline { .. } => c.other += 1,
             }
         }
         c
@@ -90,6 +94,7 @@ impl core::ops::Add for OpCounts {
             add: self.add + other.add,
             div: self.div + other.div,
             neg: self.neg + other.neg,
+            other: self.other + other.other,
         }
     }
 }
@@ -100,7 +105,12 @@ impl fmt::Display for OpCounts {
             f,
             "{} trig, {} sqrt, {} exp/ln, {} mul, {} add, {} div, {} neg",
             self.trig, self.sqrt, self.exp_ln, self.mul, self.add, self.div, self.neg
-        )
+        )?;
+        // Only scenes that use them show the other calls (the others' docs are unchanged).
+        if self.other > 0 {
+            write!(f, ", {} other", self.other)?;
+        }
+        Ok(())
     }
 }
 
@@ -148,15 +158,42 @@ pub fn table(scene: &Scene) -> String {
         .iter()
         .map(|f| f.function.len() + 1)
         .fold(17, usize::max);
+    // The column of other calls only for scenes that make them.
+    let others = functions.iter().any(|f| f.counts.other > 0);
+    let other = |value: String| {
+        if others {
+            format!("{value:>7}")
+        } else {
+            String::new()
+        }
+    };
     let mut out = format!(
-        "{:<width$}{:>8}{:>6}{:>6}{:>8}{:>6}{:>6}{:>6}{:>6}\n",
-        "function", "outputs", "trig", "sqrt", "exp/ln", "mul", "add", "div", "neg"
+        "{:<width$}{:>8}{:>6}{:>6}{:>8}{:>6}{:>6}{:>6}{:>6}{}\n",
+        "function",
+        "outputs",
+        "trig",
+        "sqrt",
+        "exp/ln",
+        "mul",
+        "add",
+        "div",
+        "neg",
+        other("other".to_owned())
     );
     for f in functions {
         let c = f.counts;
         out += &format!(
-            "{:<width$}{:>8}{:>6}{:>6}{:>8}{:>6}{:>6}{:>6}{:>6}\n",
-            f.function, f.outputs, c.trig, c.sqrt, c.exp_ln, c.mul, c.add, c.div, c.neg
+            "{:<width$}{:>8}{:>6}{:>6}{:>8}{:>6}{:>6}{:>6}{:>6}{}\n",
+            f.function,
+            f.outputs,
+            c.trig,
+            c.sqrt,
+            c.exp_ln,
+            c.mul,
+            c.add,
+            c.div,
+            c.neg,
+            other(c.other.to_string())
         );
     }
     out

@@ -95,9 +95,26 @@ where
     DefaultAllocator: Storage<M::Dim>,
 {
     type Dim = M::Dim;
+    type Markers = M::Markers;
 
     fn dim(&self) -> M::Dim {
         self.inner.dim()
+    }
+    fn marker_storage(&self) -> M::Markers {
+        self.inner.marker_storage()
+    }
+    fn marker_values(
+        &self,
+        q: &Vector<M::Dim>,
+        qd: &Vector<M::Dim>,
+        qdd: &Vector<M::Dim>,
+        t: f64,
+        out: &mut M::Markers,
+    ) {
+        self.inner.marker_values(q, qd, qdd, t, out);
+    }
+    fn marker_name(&self, index: usize) -> Option<&str> {
+        self.inner.marker_name(index)
     }
     fn coordinate_name(&self, index: usize) -> Option<&str> {
         self.inner.coordinate_name(index)

@@ -38,17 +38,19 @@ pub enum Quantity {
     Load,
     /// The solved reactions (Lagrange multipliers) of the force solve.
     Reaction,
+    /// A marker's value or rate (its index among the marker values).
+    Marker(usize),
 }
 
 impl Quantity {
     /// Writes the quantity, with `name` for a parameter or branch (its index otherwise).
     fn write(self, f: &mut fmt::Formatter<'_>, name: Option<&str>) -> fmt::Result {
         let text = match self {
-            Self::Parameter(index) | Self::Branch(index) => {
-                let what = if matches!(self, Self::Parameter(_)) {
-                    "parameter"
-                } else {
-                    "branch invariant"
+            Self::Parameter(index) | Self::Branch(index) | Self::Marker(index) => {
+                let what = match self {
+                    Self::Parameter(_) => "parameter",
+                    Self::Branch(_) => "branch invariant",
+                    _ => "marker value",
                 };
                 return match name {
                     Some(name) => write!(f, "{what} `{name}`"),
@@ -235,6 +237,7 @@ struct Names<'a> {
     coordinate: Option<&'a str>,
     branch: Option<&'a str>,
     parameter: Option<&'a str>,
+    marker: Option<&'a str>,
 }
 
 impl SolveError {
@@ -370,7 +373,7 @@ impl SolveError {
                 quantity,
                 equation: index,
             } => {
-                quantity.write(f, names.parameter.or(names.branch))?;
+                quantity.write(f, names.parameter.or(names.branch).or(names.marker))?;
                 write!(f, " became NaN or infinite at t = {time}")?;
                 if let Some(index) = index {
                     f.write_str(", first in equation ")?;
@@ -468,6 +471,10 @@ where
                 quantity: Quantity::Branch(index),
                 ..
             } => names.branch = m.branch_name(index),
+            SolveError::NonFinite {
+                quantity: Quantity::Marker(index),
+                ..
+            } => names.marker = m.marker_name(index),
             _ => {}
         }
         self.error.write(f, &names)?;

@@ -62,6 +62,7 @@ mod error;
 mod forces;
 mod geometry;
 mod lu;
+mod markers;
 pub mod math;
 mod mechanism;
 mod origin;
@@ -80,11 +81,17 @@ pub use dense::{Dense, DenseBuffers};
 pub use error::{Described, Quantity, SolveError};
 pub use geometry::{GeometryFault, MAX_LENGTH, Requirement, check_geometry};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
-pub use mechanism::{
-    Accelerations, Forces, Matrix, Mechanism, Outputs, ParameterError, ParameterNames, Storage,
-    Unit, Vector, Velocities,
+pub use markers::{
+    AnglePosition, AngleState, AngleVelocity, PointPosition, PointState, PointVelocity,
 };
-pub use reactions::{DistanceReaction, GroundLoad, PrismaticReaction, RevoluteReaction};
+pub use mechanism::{
+    Accelerations, Forces, MarkerStorage, Matrix, Mechanism, Outputs, ParameterError,
+    ParameterNames, Storage, Unit, Vector, Velocities,
+};
+pub use reactions::{
+    DistanceReaction, GearReaction, GroundLoad, PrismaticReaction, RackReaction, RevoluteReaction,
+    SlotReaction, WeldReaction,
+};
 pub use simulate::{DEFAULT_MAX_HALVINGS, Simulation, sample_time};
 pub use solver::{Convergence, Solver, SolverOptions};
 pub use state::{BodyState, Pose, PoseVelocity, State, write_csv_header};

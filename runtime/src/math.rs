@@ -46,6 +46,76 @@ pub fn sqrt(x: f64) -> f64 {
     libm::sqrt(x)
 }
 
+/// Arcsine, in [−π/2, π/2] (NaN beyond ±1).
+#[inline]
+pub fn asin(x: f64) -> f64 {
+    libm::asin(x)
+}
+
+/// Arccosine, in [0, π] (NaN beyond ±1).
+#[inline]
+pub fn acos(x: f64) -> f64 {
+    libm::acos(x)
+}
+
+/// The angle of the vector `(x, y)`, in (−π, π].
+#[inline]
+pub fn atan2(y: f64, x: f64) -> f64 {
+    libm::atan2(y, x)
+}
+
+/// `x` raised to a real power (NaN for a negative `x` and a non-integer `y`).
+#[inline]
+pub fn pow(x: f64, y: f64) -> f64 {
+    libm::pow(x, y)
+}
+
+/// `if a <= b { x } else { y }`, and NaN when `a` or `b` is NaN (never a silent choice): what
+/// `min`, `max`, `abs` and the clamped motion laws (`cycloidal`, `poly345`) compile to.
+#[inline]
+pub fn select(a: f64, b: f64, x: f64, y: f64) -> f64 {
+    if a <= b {
+        x
+    } else if b < a {
+        y
+    } else {
+        a + b
+    }
+}
+
+/// A natural cubic spline as generated code stores it: the knots, and per segment the cubic's
+/// coefficients `[a, b, c, d]` of `a + b u + c u² + d u³` in the distance `u` from the
+/// segment's base knot. Segment 0 extrapolates left of the first knot (linearly), segment k
+/// spans knots k − 1 … k, the last extrapolates right of the last knot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Spline<'a> {
+    /// Strictly increasing knots (at least two).
+    pub knots: &'a [f64],
+    /// `knots.len() + 1` segments.
+    pub segments: &'a [[f64; 4]],
+}
+
+impl Spline<'_> {
+    /// The derivative of `order` (0: the value) at `x`; NaN for a NaN `x` or a malformed
+    /// table.
+    pub fn eval(&self, x: f64, order: u8) -> f64 {
+        let k = self.knots.partition_point(|&knot| knot <= x);
+        let (Some(&base), Some(&[a, b, c, d])) =
+            (self.knots.get(k.max(1) - 1), self.segments.get(k))
+        else {
+            return f64::NAN;
+        };
+        let u = x - base;
+        match order {
+            0 => a + u * (b + u * (c + u * d)),
+            1 => b + u * (2.0 * c + u * (3.0 * d)),
+            2 => 2.0 * c + u * (6.0 * d),
+            3 => 6.0 * d + u * 0.0,
+            _ => u * 0.0,
+        }
+    }
+}
+
 /// `x` raised to an integer power (repeated multiplication, exact for small exponents).
 #[inline]
 pub fn powi(x: f64, n: i32) -> f64 {
@@ -65,6 +135,37 @@ pub fn powi(x: f64, n: i32) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn select_chooses_and_never_hides_a_nan() {
+        assert_eq!(select(1.0, 2.0, 10.0, 20.0), 10.0);
+        assert_eq!(select(2.0, 2.0, 10.0, 20.0), 10.0);
+        assert_eq!(select(3.0, 2.0, 10.0, 20.0), 20.0);
+        assert!(select(f64::NAN, 2.0, 10.0, 20.0).is_nan());
+        assert!(select(1.0, f64::NAN, 10.0, 20.0).is_nan());
+    }
+
+    #[test]
+    fn splines_evaluate_segments_and_refuse_malformed_tables() {
+        // The line y = 1 + 2x as a two-knot natural spline.
+        let spline = Spline {
+            knots: &[0.0, 1.0],
+            segments: &[
+                [1.0, 2.0, 0.0, 0.0],
+                [1.0, 2.0, 0.0, 0.0],
+                [3.0, 2.0, 0.0, 0.0],
+            ],
+        };
+        for x in [-1.0, 0.0, 0.5, 1.0, 4.0] {
+            assert_eq!(spline.eval(x, 0), 1.0 + 2.0 * x);
+            assert_eq!(spline.eval(x, 1), 2.0);
+        }
+        let broken = Spline {
+            knots: &[0.0, 1.0],
+            segments: &[],
+        };
+        assert!(broken.eval(0.5, 0).is_nan());
+    }
 
     #[test]
     fn sincos_is_sin_and_cos_to_the_bit() {

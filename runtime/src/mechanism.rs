@@ -17,6 +17,14 @@ pub type Matrix<D> = OMatrix<f64, D, D>;
 pub trait Storage<D: Dim>: Allocator<D> + Allocator<D, D> {}
 impl<D: Dim, A: Allocator<D> + Allocator<D, D>> Storage<D> for A {}
 
+/// Storage for a scene's marker values ([`Mechanism::Markers`]): `[f64; K]` for a generated
+/// scene with K values (`[f64; 0]` without markers), a `Vec` for an interpreted one.
+pub trait MarkerStorage:
+    AsRef<[f64]> + AsMut<[f64]> + Clone + core::fmt::Debug + Send + Sync
+{
+}
+impl<T: AsRef<[f64]> + AsMut<[f64]> + Clone + core::fmt::Debug + Send + Sync> MarkerStorage for T {}
+
 /// The names of a scene's parameters, in declaration order, as a [`ParameterError`] lists them:
 /// a generated scene's `&'static [&'static str]`, or an interpreted scene's strings.
 pub trait ParameterNames {
@@ -186,6 +194,9 @@ where
     /// Type-level number of coordinates (= number of equations).
     type Dim: Dim;
 
+    /// Where a solved state keeps the scene's marker values ([`Mechanism::marker_values`]).
+    type Markers: MarkerStorage;
+
     /// The number of coordinates (= number of equations), as a value of the type-level dimension.
     fn dim(&self) -> Self::Dim;
 
@@ -336,6 +347,29 @@ where
         out: &mut Vector<Self::Dim>,
     ) {
         out.as_mut_slice().fill(f64::NAN);
+    }
+
+    /// Fresh storage for the marker values (zeros).
+    fn marker_storage(&self) -> Self::Markers;
+
+    /// Writes the values of the scene's markers (`marker NAME: body @ (x, y);`: a point's world
+    /// position, `marker NAME: angle(a, b);`: `θ_b − θ_a`) and of their rates, as far as the
+    /// scene computes rates, at the state `(q, q̇, q̈)`; [`Mechanism::marker_name`] names each.
+    /// The default writes nothing (a scene without markers).
+    fn marker_values(
+        &self,
+        _q: &Vector<Self::Dim>,
+        _qd: &Vector<Self::Dim>,
+        _qdd: &Vector<Self::Dim>,
+        _t: f64,
+        _out: &mut Self::Markers,
+    ) {
+    }
+
+    /// Name of marker value `index` (`tip.x`, `tip.y`, `tip.x_dot`, …, `swing.angle`, …); `None`
+    /// past the end.
+    fn marker_name(&self, _index: usize) -> Option<&str> {
+        None
     }
 
     /// Name of the reaction [`Mechanism::reactions`] writes for equation `index`, such as

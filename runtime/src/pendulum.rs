@@ -50,9 +50,13 @@ const EQUATIONS: [&str; 3] = ["pin.x", "pin.y", "drive"];
 
 impl Mechanism for Pendulum {
     type Dim = Const<3>;
+    type Markers = [f64; 0];
 
     fn dim(&self) -> Const<3> {
         Const
+    }
+    fn marker_storage(&self) -> [f64; 0] {
+        []
     }
     fn coordinate_name(&self, index: usize) -> Option<&str> {
         COORDINATES.get(index).copied()
@@ -206,9 +210,13 @@ mod dynamic {
 
     impl Mechanism for DynPendulum {
         type Dim = Dyn;
+        type Markers = [f64; 0];
 
         fn dim(&self) -> Dyn {
             Dyn(3)
+        }
+        fn marker_storage(&self) -> [f64; 0] {
+            []
         }
         fn coordinate_name(&self, index: usize) -> Option<&str> {
             self.0.coordinate_name(index)

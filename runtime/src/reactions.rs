@@ -49,3 +49,45 @@ pub struct GroundLoad {
     /// Torque on the ground body about its reference point.
     pub torque: f64,
 }
+
+/// The reaction of a pin-in-slot joint `slot(a @ …, b @ …, along u)`: what the pin (on `b`)
+/// exerts on the slotted body `a`. The pin receives the opposite.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SlotReaction {
+    /// The normal force on `a`, along the slot's normal (its axis turned a quarter turn
+    /// anticlockwise with `a`), acting at the pin.
+    pub normal: f64,
+}
+
+/// The reaction of a weld `weld(a @ …, b @ …)`: the force (world axes) and torque `b` exerts on
+/// `a` at the weld point. `b` receives the opposite.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WeldReaction {
+    /// World x component of the force on `a`.
+    pub fx: f64,
+    /// World y component of the force on `a`.
+    pub fy: f64,
+    /// Torque on `a`.
+    pub torque: f64,
+}
+
+/// The reaction of a gear pair `gear(a, b, ratio k, carrier c)`: the torque the mesh applies to
+/// the driven gear `b`. The driving gear `a` receives `−k` times it, the carrier the rest.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GearReaction {
+    /// Torque on `b`.
+    pub torque: f64,
+}
+
+/// The reaction of a rack and pinion `rack(slide, pinion, ratio r)`: the force along the axis
+/// that the pinion applies to the rack (the prismatic joint's slider). The pinion receives the
+/// torque `−r` times it, the guide the rest.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RackReaction {
+    /// Force on the rack along the joint's axis.
+    pub force: f64,
+}

@@ -10,7 +10,9 @@ use crate::block::{BlockSolve, Factors};
 use crate::error::{Described, Quantity, SolveError};
 use crate::forces;
 use crate::lu::DEFAULT_PIVOT_TOLERANCE;
-use crate::mechanism::{Accelerations, LengthScale, Outputs, Storage, Vector, Velocities};
+use crate::mechanism::{
+    Accelerations, LengthScale, Mechanism, Outputs, Storage, Vector, Velocities,
+};
 use crate::origin;
 use crate::position::{Newton, Solved};
 use crate::state::State;
@@ -256,6 +258,16 @@ where
     }
 }
 
+/// What a full solve writes besides the motion: the reactions (for a scene that computes
+/// forces) and the marker values.
+pub(crate) struct Extras<'a, M: Mechanism>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    reactions: &'a mut Vector<M::Dim>,
+    markers: &'a mut M::Markers,
+}
+
 /// What a stage sweep computes besides positions: ordered, each level including the ones
 /// before it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -388,7 +400,10 @@ where
             &mut state.velocities,
             &mut state.accelerations,
             rates,
-            Some(&mut state.reactions),
+            Some(Extras {
+                reactions: &mut state.reactions,
+                markers: &mut state.markers,
+            }),
         )?;
         state.t = t;
         state.iterations = convergence.iterations;
@@ -432,17 +447,18 @@ where
         qd: &mut Vector<M::Dim>,
         qdd: &mut Vector<M::Dim>,
         rates: Rates,
-        reactions: Option<&mut Vector<M::Dim>>,
+        extras: Option<Extras<'_, M>>,
     ) -> Result<Convergence, SolveError> {
         self.check_inputs(t, q, Quantity::Guess)?;
         self.check_parameters(t)?;
         let mut reached = 0;
-        self.sweep(t, q, qd, qdd, rates, reactions, &mut reached)
+        self.sweep(t, q, qd, qdd, rates, extras, &mut reached)
             .map_err(|e| origin::trace(&self.mechanism, reached, [q, qd, qdd], rates, e))
     }
 
-    /// Solves the stages in order, recording in `reached` the stage being solved, then, for
-    /// [`Rates::Forces`], the force solve in reverse into `reactions`.
+    /// Solves the stages in order, recording in `reached` the stage being solved, then into
+    /// `extras` (a full solve's) the force solve in reverse for [`Rates::Forces`] and the
+    /// marker values.
     #[allow(clippy::too_many_arguments)]
     fn sweep(
         &mut self,
@@ -451,7 +467,7 @@ where
         qd: &mut Vector<M::Dim>,
         qdd: &mut Vector<M::Dim>,
         rates: Rates,
-        reactions: Option<&mut Vector<M::Dim>>,
+        extras: Option<Extras<'_, M>>,
         reached: &mut usize,
     ) -> Result<Convergence, SolveError> {
         self.update_scale();
@@ -509,9 +525,18 @@ where
         check_finite(q, t, Quantity::Phi)?;
         check_rates(qd, qdd, t, rates)?;
         check_branches(m, q, parts.trig, t)?;
-        if let (Rates::Forces, Some(reactions)) = (rates, reactions) {
-            let motion = forces::Motion { t, q, qd, qdd };
-            forces::solve(m, &mut parts, options, length, &motion, archived, reactions)?;
+        if let Some(Extras { reactions, markers }) = extras {
+            if rates == Rates::Forces {
+                let motion = forces::Motion { t, q, qd, qdd };
+                forces::solve(m, &mut parts, options, length, &motion, archived, reactions)?;
+            }
+            if !markers.as_ref().is_empty() {
+                m.markers(q, parts.trig, qd, qdd, t, markers);
+                let bad = markers.as_ref().iter().position(|v| !v.is_finite());
+                if let Some(index) = bad {
+                    return Err(non_finite(t, Quantity::Marker(index)));
+                }
+            }
         }
         Ok(total)
     }

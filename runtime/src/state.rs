@@ -60,6 +60,8 @@ where
     pub(crate) accelerations: Vector<M::Dim>,
     /// The reaction of every equation (zero unless the scene computes forces).
     pub(crate) reactions: Vector<M::Dim>,
+    /// The marker values (empty for a scene without markers).
+    pub(crate) markers: M::Markers,
     /// Newton updates the position solve needed: the most any block needed (summed over
     /// sub-steps, if any).
     pub iterations: usize,
@@ -168,6 +170,7 @@ where
             velocities: Vector::zeros_generic(dim, nalgebra::U1),
             accelerations: Vector::zeros_generic(dim, nalgebra::U1),
             reactions: Vector::zeros_generic(dim, nalgebra::U1),
+            markers: mechanism.marker_storage(),
             iterations: 0,
             substeps: 0,
             condition: f64::NAN,
@@ -187,6 +190,10 @@ where
         self.velocities.copy_from(&other.velocities);
         self.accelerations.copy_from(&other.accelerations);
         self.reactions.copy_from(&other.reactions);
+        let (ours, theirs) = (self.markers.as_mut(), other.markers.as_ref());
+        if ours.len() == theirs.len() {
+            ours.copy_from_slice(theirs);
+        }
         self.iterations = other.iterations;
         self.substeps = other.substeps;
         self.condition = other.condition;
@@ -201,15 +208,22 @@ where
         self.outputs
     }
 
+    /// The values of the scene's markers ([`Mechanism::marker_values`], named by
+    /// [`Mechanism::marker_name`]); the scene's generated accessors read them by name
+    /// (`state.tip().x`). Empty for a scene without markers.
+    pub fn marker_values(&self) -> &[f64] {
+        self.markers.as_ref()
+    }
+
     /// Pose of body `index` (declaration order); `None` past the end.
     pub fn pose(&self, index: usize) -> Option<Pose> {
         let [x, y, theta] = read3(&self.q, index)?;
         Some(Pose { x, y, theta })
     }
 
-    /// Writes `t`, then q (and q̇, q̈ when the scene computes them, and the reaction of every
-    /// equation when it computes forces) as one CSV line ending in `\n`, matching
-    /// [`write_csv_header`].
+    /// Writes `t`, then q (and q̇, q̈ when the scene computes them), the marker values, and the
+    /// reaction of every equation when the scene computes forces, as one CSV line ending in
+    /// `\n`, matching [`write_csv_header`].
     ///
     /// Numbers are the shortest strings that parse back to the same value, with an exponent
     /// for tiny and huge magnitudes (`5.2e-30`). A NaN or infinity (which a successful solve
@@ -219,14 +233,17 @@ where
     /// Whatever `out` returns.
     pub fn write_csv_row<W: Write>(&self, out: &mut W) -> fmt::Result {
         write!(out, "{:?}", self.t)?;
-        let columns = [
-            &self.q,
-            &self.velocities,
-            &self.accelerations,
-            &self.reactions,
-        ];
-        for column in columns.iter().take(column_groups(self.outputs)) {
-            for value in column.as_slice() {
+        let groups = column_groups(self.outputs);
+        let kinematics = [&self.q, &self.velocities, &self.accelerations];
+        let forces = (groups > kinematics.len()).then_some(self.reactions.as_slice());
+        let columns = kinematics
+            .iter()
+            .take(groups)
+            .map(|v| v.as_slice())
+            .chain([self.markers.as_ref()])
+            .chain(forces);
+        for column in columns {
+            for value in column {
                 write!(out, ",{value:?}")?;
             }
         }
@@ -310,7 +327,8 @@ fn column_groups(outputs: Outputs) -> usize {
 
 /// Writes the CSV header line: `t`, every coordinate name, then (when the scene computes them)
 /// the names with `_dot`, then with `_ddot` (`t,piston.x,…,piston.x_dot,…,piston.x_ddot,…\n`),
-/// then, when it computes forces, every equation's reaction by its
+/// then every marker value by its [`Mechanism::marker_name`] (`tip.x`, `tip.y`, `tip.x_dot`,
+/// …), then, when it computes forces, every equation's reaction by its
 /// [`Mechanism::reaction_name`] (`crank_pin.fx`, …, `crank_angle.effort`).
 ///
 /// A coordinate without a name is written as `q<index>`, a reaction as `reaction<index>`.
@@ -332,6 +350,9 @@ where
                 None => write!(out, ",q{index}{suffix}")?,
             }
         }
+    }
+    for name in (0..).map_while(|index| mechanism.marker_name(index)) {
+        write!(out, ",{name}")?;
     }
     if groups > suffixes.len() {
         for index in 0..n {
@@ -355,6 +376,7 @@ where
             velocities: self.velocities.clone(),
             accelerations: self.accelerations.clone(),
             reactions: self.reactions.clone(),
+            markers: self.markers.clone(),
             iterations: self.iterations,
             substeps: self.substeps,
             condition: self.condition,
@@ -379,6 +401,7 @@ where
             .field("qd", &self.velocities.as_slice())
             .field("qdd", &self.accelerations.as_slice())
             .field("reactions", &self.reactions.as_slice())
+            .field("markers", &self.markers.as_ref())
             .field("iterations", &self.iterations)
             .field("substeps", &self.substeps)
             .field("condition", &self.condition)
@@ -390,10 +413,10 @@ where
     }
 }
 
-/// `{"t", "q", "q_dot", "q_ddot", "reactions", "iterations", "evaluations", "substeps",
-/// "condition", "fallbacks", "det_sign"}`, with `q_dot`, `q_ddot` and `reactions` only for
-/// scenes that compute them (as the CSV columns) and `condition` `null` when not estimated
-/// (serde_json writes NaN as `null`).
+/// `{"t", "q", "q_dot", "q_ddot", "markers", "reactions", "iterations", "evaluations",
+/// "substeps", "condition", "fallbacks", "det_sign"}`, with `q_dot`, `q_ddot`, `markers` and
+/// `reactions` only for scenes that compute them (as the CSV columns) and `condition` `null`
+/// when not estimated (serde_json writes NaN as `null`).
 #[cfg(feature = "serde")]
 impl<M: Mechanism> serde::Serialize for State<M>
 where
@@ -402,7 +425,7 @@ where
     fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
         use serde::ser::SerializeStruct;
         let groups = column_groups(self.outputs);
-        let mut s = serializer.serialize_struct("State", 7 + groups)?;
+        let mut s = serializer.serialize_struct("State", 8 + groups)?;
         s.serialize_field("t", &self.t)?;
         s.serialize_field("q", self.q.as_slice())?;
         if groups >= 2 {
@@ -414,6 +437,12 @@ where
             s.serialize_field("q_ddot", self.accelerations.as_slice())?;
         } else {
             s.skip_field("q_ddot")?;
+        }
+        let markers = self.markers.as_ref();
+        if markers.is_empty() {
+            s.skip_field("markers")?;
+        } else {
+            s.serialize_field("markers", markers)?;
         }
         if groups >= 4 {
             s.serialize_field("reactions", self.reactions.as_slice())?;

@@ -170,6 +170,20 @@ where
         self.branch_value(index, q)
     }
 
+    /// The marker values at the solved state, with every stage's trig cached:
+    /// [`Mechanism::marker_values`], which generated scenes evaluate from the cache.
+    fn markers(
+        &self,
+        q: &Vector<Self::Dim>,
+        _trig: &[f64],
+        qd: &Vector<Self::Dim>,
+        qdd: &Vector<Self::Dim>,
+        t: f64,
+        out: &mut Self::Markers,
+    ) {
+        self.marker_values(q, qd, qdd, t, out);
+    }
+
     /// Factors a block's (scaled) Jacobian values in place with its static pivot order.
     ///
     /// # Errors

@@ -275,6 +275,50 @@ impl<'a> NewtonEuler<'a> {
                     self.force(a.body, f, pa);
                     self.force(b.body, [-f[0], -f[1]], pb);
                 }
+                ConstraintKind::Slot { a, b, axis } => {
+                    let u = [self.value(axis[0]), self.value(axis[1])];
+                    let n = self.rotate(a.body, [-u[1], u[0]]);
+                    let at = self.world(b);
+                    self.force(a.body, [r[0] * n[0], r[0] * n[1]], at);
+                    self.force(b.body, [-r[0] * n[0], -r[0] * n[1]], at);
+                }
+                ConstraintKind::Weld { a, b, .. } => {
+                    self.force(a.body, [r[0], r[1]], self.world(a));
+                    self.force(b.body, [-r[0], -r[1]], self.world(b));
+                    self.torque(a.body, r[2]);
+                    self.torque(b.body, -r[2]);
+                }
+                ConstraintKind::Gear {
+                    a,
+                    b,
+                    carrier,
+                    ratio,
+                    ..
+                } => {
+                    let k = self.value(ratio);
+                    self.torque(b, r[0]);
+                    self.torque(a, -k * r[0]);
+                    if let Some(c) = carrier {
+                        self.torque(c, (k - 1.0) * r[0]);
+                    }
+                }
+                ConstraintKind::Rack {
+                    a,
+                    b,
+                    axis,
+                    pinion,
+                    ratio,
+                    ..
+                } => {
+                    let u = [self.value(axis[0]), self.value(axis[1])];
+                    let u = self.rotate(a.body, u);
+                    let at = self.world(b);
+                    self.force(b.body, [r[0] * u[0], r[0] * u[1]], at);
+                    self.force(a.body, [-r[0] * u[0], -r[0] * u[1]], at);
+                    let k = self.value(ratio);
+                    self.torque(pinion, -k * r[0]);
+                    self.torque(a.body, k * r[0]);
+                }
                 ConstraintKind::Driver { driven, .. } => match driven {
                     Driven::Angle(b) => self.torque(b, r[0]),
                     Driven::RelativeAngle(a, b) => {
@@ -289,6 +333,14 @@ impl<'a> NewtonEuler<'a> {
                         let at = self.world(b);
                         self.force(b.body, [r[0] * u[0], r[0] * u[1]], at);
                         self.force(a.body, [-r[0] * u[0], -r[0] * u[1]], at);
+                    }
+                    Driven::Distance(a, b) => {
+                        let (pa, pb) = (self.world(a), self.world(b));
+                        let d = [pb[0] - pa[0], pb[1] - pa[1]];
+                        let l = d[0].hypot(d[1]);
+                        let u = [d[0] / l, d[1] / l];
+                        self.force(b.body, [r[0] * u[0], r[0] * u[1]], pb);
+                        self.force(a.body, [-r[0] * u[0], -r[0] * u[1]], pa);
                     }
                 },
             }

@@ -19,7 +19,7 @@
 use std::cell::RefCell;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
-use mechgen::expr::Func;
+use mechgen::expr::{Func, Func2};
 use mechgen::interpret::{Inputs, Scalar, Tape};
 use mechgen_runtime::nalgebra::{DefaultAllocator, Dim, U1};
 use mechgen_runtime::{
@@ -147,9 +147,14 @@ impl std::error::Error for MethodError {}
 macro_rules! delegate_to_inner {
     () => {
         type Dim = M::Dim;
+        type Markers = M::Markers;
 
         fn dim(&self) -> M::Dim {
             self.inner.dim()
+        }
+
+        fn marker_storage(&self) -> M::Markers {
+            self.inner.marker_storage()
         }
 
         fn coordinate_name(&self, index: usize) -> Option<&str> {
@@ -469,7 +474,28 @@ impl Scalar for Ad {
             Func::Exp => x.exp(),
             Func::Ln => x.ln(),
             Func::Sqrt => x.sqrt(),
+            Func::Asin => x.asin(),
+            Func::Acos => x.acos(),
         })
+    }
+
+    #[inline]
+    fn apply2(self, function: Func2, other: Self) -> Self {
+        let (a, b) = (self.0, other.0);
+        Ad(match function {
+            // atan2(y, x)' = (x dy − y dx) / (x² + y²).
+            Func2::Atan2 => {
+                let value = a.re.atan2(b.re);
+                let slope = (b.re * a.eps - a.re * b.eps) / (a.re * a.re + b.re * b.re);
+                Dual64::new(value, slope)
+            }
+            Func2::Pow => a.powd(b),
+        })
+    }
+
+    #[inline]
+    fn primal(self) -> f64 {
+        self.0.re
     }
 }
 

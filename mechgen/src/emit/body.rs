@@ -103,6 +103,8 @@ pub(super) struct Context<'a> {
     pub kinematics_branches: &'a [Id],
     /// The force solve, for a scene that computes forces.
     pub forces: Option<&'a crate::reactions::Forces>,
+    /// The markers' values (from the kinematics).
+    pub markers: &'a [Id],
     pub options: &'a CodegenOptions,
     /// Helper functions of split bodies, emitted in an inherent `impl` block.
     pub helpers: RefCell<Vec<TokenStream>>,
@@ -383,10 +385,28 @@ impl Context<'_> {
                     let a = operand(a).0;
                     (quote!(#f_ident(#a)), Prec::Atom)
                 }
+                Node::Call2(f, a, b) => {
+                    funcs.insert(f.name());
+                    let f_ident = format_ident!("{}", f.name());
+                    let (a, b) = (operand(a).0, operand(b).0);
+                    (quote!(#f_ident(#a, #b)), Prec::Atom)
+                }
+                Node::Select(a, b, x, y) => {
+                    funcs.insert("select");
+                    let [a, b, x, y] = [a, b, x, y].map(|o| operand(o).0);
+                    (quote!(select(#a, #b, #x, #y)), Prec::Atom)
+                }
+                Node::Spline { table, order, x } => {
+                    let table = format_ident!("SPLINE_{}", table);
+                    let order = Literal::u8_unsuffixed(order);
+                    let x = operand(x).0;
+                    (quote!(Self::#table.eval(#x, #order)), Prec::Atom)
+                }
             };
             let is_leaf = matches!(node, Node::Const(_) | Node::Param(_) | Node::Var(Var::T));
             // Coordinates are loaded once; the naive baseline shares nothing else.
-            let shared = matches!(node, Node::Call(..)) || uses.get(&id).copied().unwrap_or(0) > 1;
+            let call = matches!(node, Node::Call(..) | Node::Call2(..) | Node::Spline { .. });
+            let shared = call || uses.get(&id).copied().unwrap_or(0) > 1;
             let bind =
                 !is_leaf && (matches!(node, Node::Var(_)) || (shared && !self.options.naive));
             if bind {
@@ -456,6 +476,8 @@ impl Context<'_> {
                 Node::Var(Var::Q(k)) => format!("{}_{}", f.name(), coordinate(k)),
                 _ => f.name().to_owned() + "_",
             },
+            Node::Call2(f, ..) => f.name().to_owned() + "_",
+            Node::Spline { .. } => "law_".to_owned(),
             _ => "e".to_owned(),
         }
     }

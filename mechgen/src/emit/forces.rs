@@ -105,71 +105,27 @@ impl Context<'_> {
         let mut row = 0;
         for constraint in &model.constraints {
             let field = format_ident!("{}", constraint.name);
-            let at = |k: usize| idx(row + k);
-            let (doc, ty, value) = match constraint.kind {
-                ConstraintKind::Ground { .. } => {
-                    let [x, y, z] = [at(0), at(1), at(2)];
-                    (
-                        format!(
-                            " Ground body `{}`: the force (world axes) and torque (about its \
-                             reference point) the mechanism exerts on it.",
-                            constraint.name
-                        ),
-                        quote!(#runtime::GroundLoad),
-                        quote!(#runtime::GroundLoad { fx: r[#x], fy: r[#y], torque: r[#z] }),
-                    )
-                }
-                ConstraintKind::Revolute { a, b } => {
-                    let [x, y] = [at(0), at(1)];
-                    (
-                        format!(
-                            " Revolute joint `{}`: the force (world axes) `{}` exerts on `{}`.",
-                            constraint.name,
-                            self.body_name(b.body),
-                            self.body_name(a.body)
-                        ),
-                        quote!(#runtime::RevoluteReaction),
-                        quote!(#runtime::RevoluteReaction { fx: r[#x], fy: r[#y] }),
-                    )
-                }
-                ConstraintKind::Prismatic { a, b, .. } => {
-                    let [normal, torque] = [at(0), at(1)];
-                    (
-                        format!(
-                            " Prismatic joint `{}`: the normal force and torque `{}` exerts on \
-                             `{}`.",
-                            constraint.name,
-                            self.body_name(b.body),
-                            self.body_name(a.body)
-                        ),
-                        quote!(#runtime::PrismaticReaction),
-                        quote!(#runtime::PrismaticReaction { normal: r[#normal], torque: r[#torque] }),
-                    )
-                }
-                ConstraintKind::Distance { .. } => {
-                    let tension = at(0);
-                    (
-                        format!(" Distance joint `{}`: its tension.", constraint.name),
-                        quote!(#runtime::DistanceReaction),
-                        quote!(#runtime::DistanceReaction { tension: r[#tension] }),
-                    )
-                }
-                ConstraintKind::Driver { .. } => {
-                    let effort = at(0);
-                    let doc = format!(
-                        " Driver `{}`: the generalised force it applies along its coordinate \
-                         (a torque for angles, a force for positions and travel).",
-                        constraint.name
-                    );
-                    effort_fields.push(quote! { #[doc = #doc] pub #field: f64, });
-                    effort_values.push(quote! { #field: r[#effort], });
-                    row += 1;
-                    continue;
-                }
+            let suffixes = constraint.kind.reaction_suffixes();
+            let rows = row..row + suffixes.len();
+            row = rows.end;
+            let Some((ty, doc)) = self.reaction_type(&constraint.name, &constraint.kind) else {
+                let doc = format!(
+                    " Driver `{}`: the generalised force it applies along its coordinate (a \
+                     torque for angles, a force for positions, travel and distances).",
+                    constraint.name
+                );
+                let effort = idx(rows.start);
+                effort_fields.push(quote! { #[doc = #doc] pub #field: f64, });
+                effort_values.push(quote! { #field: r[#effort], });
+                continue;
             };
-            reaction_fields.push(quote! { #[doc = #doc] pub #field: #ty, });
-            reaction_values.push(quote! { #field: #value, });
-            row += constraint.kind.equation_suffixes().len();
+            let ty = format_ident!("{}", ty);
+            let values = suffixes.iter().zip(rows).map(|(suffix, k)| {
+                let (name, k) = (format_ident!("{}", suffix), idx(k));
+                quote!(#name: r[#k])
+            });
+            reaction_fields.push(quote! { #[doc = #doc] pub #field: #runtime::#ty, });
+            reaction_values.push(quote! { #field: #runtime::#ty { #(#values),* }, });
         }
         let reactions_doc = format!(
             " The reactions of a solved [`{name}`] state: a field per joint and ground body, in \
@@ -216,6 +172,76 @@ impl Context<'_> {
                 }
             }
         }
+    }
+
+    /// The runtime type of a constraint's reaction (its fields are the reaction suffixes) and
+    /// the accessor field's doc; `None` for a driver (its effort is a number).
+    fn reaction_type(&self, name: &str, kind: &ConstraintKind) -> Option<(&'static str, String)> {
+        let by = |a: usize, b: usize| (self.body_name(b), self.body_name(a));
+        Some(match *kind {
+            ConstraintKind::Ground { .. } => (
+                "GroundLoad",
+                format!(
+                    " Ground body `{name}`: the force (world axes) and torque (about its \
+                     reference point) the mechanism exerts on it."
+                ),
+            ),
+            ConstraintKind::Revolute { a, b } => {
+                let (from, on) = by(a.body, b.body);
+                (
+                    "RevoluteReaction",
+                    format!(
+                        " Revolute joint `{name}`: the force (world axes) `{from}` exerts on `{on}`."
+                    ),
+                )
+            }
+            ConstraintKind::Prismatic { a, b, .. } => {
+                let (from, on) = by(a.body, b.body);
+                (
+                    "PrismaticReaction",
+                    format!(
+                        " Prismatic joint `{name}`: the normal force and torque `{from}` exerts on `{on}`."
+                    ),
+                )
+            }
+            ConstraintKind::Distance { .. } => (
+                "DistanceReaction",
+                format!(" Distance joint `{name}`: its tension."),
+            ),
+            ConstraintKind::Slot { a, b, .. } => {
+                let (from, on) = by(a.body, b.body);
+                (
+                    "SlotReaction",
+                    format!(
+                        " Pin-in-slot joint `{name}`: the normal force the pin of `{from}` exerts on `{on}`."
+                    ),
+                )
+            }
+            ConstraintKind::Weld { a, b, .. } => {
+                let (from, on) = by(a.body, b.body);
+                (
+                    "WeldReaction",
+                    format!(
+                        " Weld `{name}`: the force (world axes) and torque `{from}` exerts on `{on}`."
+                    ),
+                )
+            }
+            ConstraintKind::Gear { b, .. } => (
+                "GearReaction",
+                format!(
+                    " Gear pair `{name}`: the torque the mesh applies to `{}`.",
+                    self.body_name(b)
+                ),
+            ),
+            ConstraintKind::Rack { b, .. } => (
+                "RackReaction",
+                format!(
+                    " Rack and pinion `{name}`: the force along the axis the pinion applies to `{}`.",
+                    self.body_name(b.body)
+                ),
+            ),
+            ConstraintKind::Driver { .. } => return None,
+        })
     }
 
     fn body_name(&self, body: usize) -> String {

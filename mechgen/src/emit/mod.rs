@@ -8,6 +8,7 @@
 
 mod body;
 mod forces;
+mod markers;
 mod plan;
 
 use std::cell::RefCell;
@@ -60,6 +61,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
         equations: scene.model.equation_names(),
         kinematics_branches: &scene.kinematics.branches,
         forces: scene.forces.as_ref(),
+        markers: &scene.kinematics.markers,
         options,
         helpers: RefCell::new(Vec::new()),
     };
@@ -153,6 +155,8 @@ impl Context<'_> {
         let equation_units = unit_list(model.equation_units());
         let branch_names = self.branch_names();
         let reaction_names = self.forces.map(|_| self.reaction_names());
+        let splines = self.spline_tables();
+        let marker_names = self.marker_names();
         let coordinate_doc = format!(
             " Coordinate names in q order ({n} = 3 × {} bodies).",
             model.bodies.len()
@@ -180,6 +184,8 @@ impl Context<'_> {
                 pub const EQUATION_UNITS: [::mechgen_runtime::Unit; #n_lit] = #equation_units;
                 #branch_names
                 #reaction_names
+                #splines
+                #marker_names
                 #(#coordinate_consts)*
             }
         }
@@ -210,6 +216,7 @@ impl Context<'_> {
         let branch_methods = self.branch_methods(kin);
         let equations = self.textbook_functions(kin);
         let force_methods = self.forces.map(|forces| self.force_methods(forces));
+        let marker_methods = self.marker_methods(self.markers);
         let (outputs_variant, markers) = match model.outputs {
             Outputs::Positions => (quote!(Positions), TokenStream::new()),
             Outputs::Velocities => (
@@ -235,6 +242,7 @@ impl Context<'_> {
         quote! {
             impl ::mechgen_runtime::Mechanism for #name {
                 type Dim = ::mechgen_runtime::nalgebra::Const<#n_lit>;
+                #marker_methods
 
                 fn dim(&self) -> Self::Dim {
                     ::mechgen_runtime::nalgebra::Const::<#n_lit>
@@ -443,6 +451,7 @@ impl Context<'_> {
             };
             quote! { #docs fn #ident(&self) -> ::mechgen_runtime::#view; }
         });
+        let (marker_declarations, marker_implementations) = self.marker_accessors();
         let implementations = model.bodies.iter().enumerate().map(|(i, b)| {
             let ident = &b.name;
             let [x, y, th] = [3 * i, 3 * i + 1, 3 * i + 2].map(idx);
@@ -468,10 +477,12 @@ impl Context<'_> {
             #[doc = #bodies_doc]
             #vis trait #bodies_trait {
                 #(#declarations)*
+                #(#marker_declarations)*
             }
 
             impl #bodies_trait for ::mechgen_runtime::State<#name> {
                 #(#implementations)*
+                #(#marker_implementations)*
             }
         }
     }
@@ -641,6 +652,38 @@ impl Context<'_> {
                 ::core::result::Result::Ok(())
             }
         }
+    }
+
+    /// The spline tables of the scene's motion laws, as `SPLINE_k` constants the function
+    /// bodies evaluate (`Self::SPLINE_k.eval(x, order)`); nothing for a scene without splines.
+    fn spline_tables(&self) -> TokenStream {
+        let tables = self
+            .arena()
+            .spline_tables()
+            .iter()
+            .enumerate()
+            .map(|(k, table)| {
+                let name = format_ident!("SPLINE_{}", k);
+                let knots = table.knots.iter().map(|&x| f64_literal(x));
+                let segments = table.segments.iter().map(|segment| {
+                    let coefficients = segment.iter().map(|&c| f64_literal(c));
+                    quote!([#(#coefficients),*])
+                });
+                let doc = format!(
+                    " Motion law {k}: the natural cubic spline through {} points.",
+                    table.knots.len()
+                );
+                quote! {
+                    #[doc = #doc]
+                    #[allow(dead_code)]
+                    const #name: ::mechgen_runtime::math::Spline<'static> =
+                        ::mechgen_runtime::math::Spline {
+                            knots: &[#(#knots),*],
+                            segments: &[#(#segments),*],
+                        };
+                }
+            });
+        quote!(#(#tables)*)
     }
 
     /// The `BRANCHES` names (nothing for a scene without branch invariants).

@@ -38,6 +38,7 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
     let views = [("trig", &trig_len), ("lambda", &n_lit)];
     let factor_functions = shared.functions(cx);
     let branch = branch_method(cx, plan);
+    let markers = cx.markers_method(cx.markers, plan);
     let vector = quote!(::mechgen_runtime::Vector<Self::Dim>);
     let slice = quote!([f64]);
     let k = &kernels;
@@ -219,6 +220,7 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
 
             #(#methods)*
             #branch
+            #markers
         }
     }
 }

@@ -102,6 +102,11 @@ impl SliderCrank {
 
 impl Mechanism for SliderCrank {
     type Dim = Const<9>;
+    type Markers = [f64; 0];
+
+    fn marker_storage(&self) -> [f64; 0] {
+        []
+    }
 
     fn dim(&self) -> Const<9> {
         Const

@@ -1,4 +1,5 @@
-//! Syntax: `^` with a non-integer exponent (`t^0.5`); the error points at the exponent.
+//! A real power of a negative constant (`(-2)^0.5` is NaN); the error points at the power and
+//! says integer exponents work for negative bases.
 use mechgen_runtime::mechanism;
 
 mechanism! {
@@ -12,7 +13,7 @@ mechanism! {
         joint crank_pin: revolute(crank @ (1, 0), rod);
         joint wrist_pin: revolute(rod @ (2, 0), slider);
         joint slide: prismatic(frame, slider, along (1, 0));
-        driver spin: angle(crank) = omega * t^0.5;
+        driver spin: angle(crank) = omega * t * (-2)^0.5;
     }
 }
 
