@@ -163,9 +163,9 @@ struct Checker {
 }
 
 impl Checker {
-    /// Every declared name is unique across parameters, bodies, joints, drivers and branches
-    /// (they share the generated namespace: fields, accessors, equation and branch names); `t` is
-    /// reserved.
+    /// Every declared name is unique across parameters, bodies, joints, drivers, branches,
+    /// loads and markers (they share the generated namespace: fields, accessors, equation,
+    /// branch and column names); `t` and `pi` are reserved.
     fn check_names(&mut self, spec: &Spec) {
         let mut seen: HashMap<String, &str> = HashMap::new();
         let names = spec
@@ -208,7 +208,7 @@ impl Checker {
             self.bodies.entry(body.name.to_string()).or_insert(i);
         }
         for (i, param) in spec.params.iter().enumerate() {
-            let index = u32::try_from(i).unwrap_or(u32::MAX);
+            let index = crate::expr::var_index(i);
             self.params.entry(param.name.to_string()).or_insert(index);
         }
         if !spec.bodies.iter().any(|b| !b.ground) {

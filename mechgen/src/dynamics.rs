@@ -18,7 +18,7 @@
 use std::collections::HashMap;
 
 use crate::diff::Differentiator;
-use crate::expr::{Arena, Func, Id, Var};
+use crate::expr::{Arena, Func, Id, Var, var_index};
 use crate::kinematics::{Frames, ground_poses};
 use crate::model::{LoadKind, Model, Point};
 
@@ -36,7 +36,7 @@ pub fn ground_spring_loads(model: &mut Model) -> Vec<Id> {
         .flat_map(|(i, b)| {
             let zero = model.arena.zero();
             (0..3).flat_map(move |k| {
-                let c = index(3 * i + k);
+                let c = var_index(3 * i + k);
                 [(Var::Q(c), b.pose[k]), (Var::Qd(c), zero)]
             })
         })
@@ -193,37 +193,37 @@ impl Work<'_> {
         });
         self.apply(force, centre);
         let arena = &mut *self.frames.arena;
-        let angular = arena.var(Var::Qdd(index(3 * body + 2)));
+        let angular = arena.var(Var::Qdd(var_index(3 * body + 2)));
         let moment = arena.mul(mass.inertia, angular);
         let torque = arena.neg(moment);
         self.torque(body, torque);
     }
 
-    /// A spring-damper between two points: tension `T = k (ℓ − L) + c ℓ̇`, contributing
-    /// `−T ∂ℓ/∂q_k` (it pulls the points together when stretched).
+    /// A spring-damper between two points: tension `T = k (ℓ − L) + c ℓ̇` along `d = P_b − P_a`,
+    /// pulling `a` by `T d/ℓ` and `b` by the opposite (toward each other when stretched).
+    ///
+    /// Written per unit length, `T/ℓ = k (1 − L/ℓ) + c (d·ḋ)/ℓ²`, so that a zero-length
+    /// spring's force `k d` stays finite where its points meet; otherwise its direction, and
+    /// the force, are undefined there.
     fn spring(&mut self, a: Point, b: Point, [stiffness, length, damping]: [Id; 3]) {
+        let (at_a, at_b) = (self.frames.world_point(a), self.frames.world_point(b));
         let d = self.frames.separation(a, b);
         let squared = self.frames.dot(d, d);
+        let rate = d.map(|x| self.d.time_derivative(self.frames.arena, x));
+        let approach = self.frames.dot(d, rate);
         let arena = &mut *self.frames.arena;
         let distance = arena.call(Func::Sqrt, squared);
-        let rate = self.d.time_derivative(arena, distance);
-        let stretch = arena.sub(distance, length);
-        let elastic = arena.mul(stiffness, stretch);
-        let viscous = arena.mul(damping, rate);
-        let tension = arena.add(elastic, viscous);
-        for var in arena.variables(distance) {
-            let Var::Q(k) = var else { continue };
-            let arena = &mut *self.frames.arena;
-            let partial = self.d.diff(arena, distance, var);
-            let pull = arena.mul(tension, partial);
-            let force = arena.neg(pull);
-            self.add(k as usize, force);
-        }
+        let rest = arena.mul(stiffness, length);
+        let shrink = arena.div(rest, distance);
+        let elastic = arena.sub(stiffness, shrink);
+        let damped = arena.mul(damping, approach);
+        let viscous = arena.div(damped, squared);
+        let per_length = arena.add(elastic, viscous);
+        let pull = d.map(|x| arena.mul(per_length, x));
+        let push = pull.map(|x| arena.neg(x));
+        self.apply(pull, at_a);
+        self.apply(push, at_b);
     }
-}
-
-fn index(k: usize) -> u32 {
-    u32::try_from(k).unwrap_or(u32::MAX)
 }
 
 #[cfg(test)]

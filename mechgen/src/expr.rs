@@ -37,6 +37,13 @@ pub enum Var {
     T,
 }
 
+/// The `u32` index a [`Var`] carries for coordinate, equation or parameter `k`.
+///
+/// A scene has far fewer than 2³² of each (the generated arrays would not compile otherwise).
+pub(crate) fn var_index(k: usize) -> u32 {
+    u32::try_from(k).expect("a scene has fewer than 2^32 coordinates and equations")
+}
+
 /// Elementary functions of one argument.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Func {

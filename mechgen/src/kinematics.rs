@@ -7,7 +7,7 @@
 //! γ = −(∂Φ̇/∂q · q̇ + ∂Φ̇/∂t) = −(Φ_q q̇)_q q̇ − 2 Φ_qt q̇ − Φ_tt.
 
 use crate::diff::Differentiator;
-use crate::expr::{Arena, Id, Node, Var};
+use crate::expr::{Arena, Id, Node, Var, var_index};
 use crate::model::{Branch, ConstraintKind, Driven, Model, Outputs, Point, Product, Sign};
 
 /// A structural non-zero of the Jacobian.
@@ -211,7 +211,7 @@ fn acceleration_rhs(
     for (row, &phi_t_i) in phi_t.iter().enumerate() {
         let mut phi_dot = phi_t_i;
         for e in jacobian.iter().filter(|e| e.row == row) {
-            let qd = arena.var(Var::Qd(col_u32(e.col)));
+            let qd = arena.var(Var::Qd(var_index(e.col)));
             let term = arena.mul(e.value, qd);
             phi_dot = arena.add(phi_dot, term);
         }
@@ -227,10 +227,6 @@ fn acceleration_rhs(
         gamma.push(arena.neg(total));
     }
     gamma
-}
-
-fn col_u32(col: usize) -> u32 {
-    u32::try_from(col).unwrap_or(u32::MAX)
 }
 
 /// Φ in equation order, from the model's constraints.
@@ -264,7 +260,7 @@ fn equations_with(model: &mut Model, poses: &[Option<[Id; 3]>]) -> Vec<Id> {
         match kind {
             ConstraintKind::Ground { body, pose } => {
                 for (k, target) in pose.into_iter().enumerate() {
-                    let q = f.arena.var(Var::Q(col_u32(3 * body + k)));
+                    let q = f.arena.var(Var::Q(var_index(3 * body + k)));
                     phi.push(f.arena.sub(q, target));
                 }
             }
@@ -345,7 +341,7 @@ impl Frames<'_> {
     pub(crate) fn pose(&mut self, body: usize, k: usize) -> Id {
         match self.poses.get(body).copied().flatten() {
             Some(pose) => pose[k],
-            None => self.arena.var(Var::Q(col_u32(3 * body + k))),
+            None => self.arena.var(Var::Q(var_index(3 * body + k))),
         }
     }
 

@@ -87,10 +87,19 @@ impl Scene {
     /// computes forces its dynamics and the force solve's structure.
     fn derive(mut model: Model) -> Self {
         let kinematics = kinematics::derive(&mut model);
-        let plan = structure::plan(&mut model, &kinematics);
+        let mut plan = structure::plan(&mut model, &kinematics);
         let forces = (model.outputs >= model::Outputs::Forces).then(|| {
             let generalized = dynamics::derive(&mut model);
-            reactions::plan(&mut model, &kinematics, &plan, generalized)
+            let forces = reactions::plan(&mut model, &kinematics, &plan, generalized);
+            let reads: Vec<expr::Id> = kinematics
+                .markers
+                .iter()
+                .chain(forces.kernel_roots())
+                .copied()
+                .collect();
+            let n = model.dim();
+            plan.cache_final_reads(&mut model.arena, n, &reads);
+            forces
         });
         Scene {
             model,

@@ -587,11 +587,6 @@ impl Model {
         )
     }
 
-    /// Whether anything in the scene produces a force: a body's mass properties or a load.
-    pub fn has_dynamics(&self) -> bool {
-        self.bodies.iter().any(|b| b.mass.is_some()) || !self.loads.is_empty()
-    }
-
     /// Number of drivers (the mechanism's degrees of freedom, checked).
     pub fn driver_count(&self) -> usize {
         self.constraints

@@ -24,7 +24,7 @@
 use std::collections::HashMap;
 
 use crate::diff::Differentiator;
-use crate::expr::{Arena, Id, Var};
+use crate::expr::{Arena, Id, Var, var_index};
 use crate::kinematics::Kinematics;
 use crate::model::{ConstraintKind, Model};
 use crate::structure::{Plan, Stage};
@@ -54,6 +54,13 @@ pub enum ForceStage {
 }
 
 impl Forces {
+    /// The expressions of the force solve's kernels (run after the forward sweep).
+    pub fn kernel_roots(&self) -> impl Iterator<Item = &Id> {
+        self.stages.iter().flat_map(|stage| match stage {
+            ForceStage::Explicit(values) | ForceStage::Block(values) => values,
+        })
+    }
+
     /// The non-zero outputs of the textbook force functions, by name (for operation counts).
     pub fn function_outputs(&self, arena: &Arena) -> Vec<(&'static str, Vec<Id>)> {
         let nonzero = |ids: &[Id]| -> Vec<Id> {
@@ -115,7 +122,7 @@ pub fn plan(model: &mut Model, kin: &Kinematics, plan: &Plan, generalized: Vec<I
 fn known_values(arena: &Arena, plan: &Plan) -> HashMap<Var, Id> {
     let mut known = HashMap::new();
     for a in plan.assignments() {
-        let c = index(a.coordinate);
+        let c = var_index(a.coordinate);
         let values = [
             (Var::Q(c), Some(a.position)),
             (Var::Qd(c), a.velocity),
@@ -155,7 +162,7 @@ impl Transpose<'_> {
                 continue;
             }
             let value = self.known(value);
-            let lambda = self.arena.var(Var::Lambda(index(i)));
+            let lambda = self.arena.var(Var::Lambda(var_index(i)));
             let term = self.arena.mul(value, lambda);
             rest = self.arena.sub(rest, term);
         }
@@ -163,60 +170,28 @@ impl Transpose<'_> {
     }
 
     /// The multipliers of an explicit stage's (equation, coordinate) assignments, each divided
-    /// by its coefficient and with the stage's own multipliers substituted in dependency order.
+    /// by its coefficient and with the stage's own multipliers substituted.
+    ///
+    /// The forward sweep solved the assignments one after another, so an equation touches only
+    /// its own coordinate and earlier ones: a coordinate's column holds its own equation and
+    /// later ones. In reverse order every multiplier reads only multipliers already resolved.
     fn explicit(&mut self, assignments: &[(usize, usize)]) -> Vec<Id> {
-        let raw: Vec<Id> = assignments
-            .iter()
-            .map(|&(e, c)| {
-                let rest = self.remainder(c, &[e]);
-                let coefficient = self.columns[c]
-                    .iter()
-                    .find(|(i, _)| *i == e)
-                    .map_or(self.arena.one(), |&(_, v)| v);
-                let coefficient = self.known(coefficient);
-                divide(self.arena, rest, coefficient)
-            })
-            .collect();
-        let own: HashMap<Var, usize> = assignments
-            .iter()
-            .enumerate()
-            .map(|(k, &(e, _))| (Var::Lambda(index(e)), k))
-            .collect();
-        // An assignment's multiplier reads the multipliers of the stage's assignments that
-        // were solved after it (those touch its coordinate); resolve those first. The plan
-        // solved them one after another, so there is always one left that reads no unresolved
-        // one.
         let mut resolved: HashMap<Var, Id> = HashMap::new();
-        let mut values: Vec<Option<Id>> = vec![None; raw.len()];
-        while values.iter().any(Option::is_none) {
-            let mut progress = false;
-            for k in 0..raw.len() {
-                if values[k].is_some() {
-                    continue;
-                }
-                let ready = self
-                    .arena
-                    .variables(raw[k])
-                    .iter()
-                    .all(|v| !own.contains_key(v) || resolved.contains_key(v));
-                if ready {
-                    let value = self
-                        .arena
-                        .substitute(raw[k], &resolved, &mut HashMap::new());
-                    resolved.insert(Var::Lambda(index(assignments[k].0)), value);
-                    values[k] = Some(value);
-                    progress = true;
-                }
-            }
-            if !progress {
-                break;
-            }
+        let mut values = vec![self.arena.zero(); assignments.len()];
+        for (k, &(e, c)) in assignments.iter().enumerate().rev() {
+            let rest = self.remainder(c, &[e]);
+            let coefficient = self.columns[c]
+                .iter()
+                .find(|(i, _)| *i == e)
+                .map(|&(_, v)| v)
+                .expect("the plan assigns a coordinate through an equation that touches it");
+            let coefficient = self.known(coefficient);
+            let raw = divide(self.arena, rest, coefficient);
+            let value = self.arena.substitute(raw, &resolved, &mut HashMap::new());
+            resolved.insert(Var::Lambda(var_index(e)), value);
+            values[k] = value;
         }
         values
-            .into_iter()
-            .zip(raw)
-            .map(|(value, raw)| value.unwrap_or(raw))
-            .collect()
     }
 }
 
@@ -238,7 +213,7 @@ fn reported(model: &mut Model, kin: &Kinematics) -> Vec<Id> {
     let mut reactions = Vec::with_capacity(kin.phi.len());
     for kind in kinds {
         let first = reactions.len();
-        let lambda = |arena: &mut Arena, k: usize| arena.var(Var::Lambda(index(first + k)));
+        let lambda = |arena: &mut Arena, k: usize| arena.var(Var::Lambda(var_index(first + k)));
         match kind {
             ConstraintKind::Ground { body, .. } => {
                 reactions.extend((0..3).map(|k| loads[3 * body + k]));
@@ -305,7 +280,7 @@ fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
     let arena = &mut model.arena;
     let pose: HashMap<Var, Id> = ground
         .iter()
-        .flat_map(|&(body, pose)| (0..3).map(move |k| (Var::Q(index(3 * body + k)), pose[k])))
+        .flat_map(|&(body, pose)| (0..3).map(move |k| (Var::Q(var_index(3 * body + k)), pose[k])))
         .collect();
     let mut memo = HashMap::new();
     let mut d = Differentiator::new();
@@ -321,14 +296,10 @@ fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
             }
             let partial = d.diff(arena, phi, var);
             let partial = arena.substitute(partial, &pose, &mut memo);
-            let lambda = arena.var(Var::Lambda(index(i)));
+            let lambda = arena.var(Var::Lambda(var_index(i)));
             let term = arena.mul(partial, lambda);
             loads[k] = arena.sub(loads[k], term);
         }
     }
     loads
-}
-
-fn index(k: usize) -> u32 {
-    u32::try_from(k).unwrap_or(u32::MAX)
 }

@@ -24,7 +24,7 @@
 use std::collections::HashMap;
 
 use crate::diff::Differentiator;
-use crate::expr::{Arena, Func, Id, Node, Var};
+use crate::expr::{Arena, Func, Id, Node, Var, var_index};
 use crate::factor::{self, Factorization};
 use crate::graph;
 use crate::interpret::{Inputs, Tape};
@@ -246,11 +246,19 @@ pub fn plan(model: &mut Model, kin: &Kinematics) -> Plan {
         }
     }
     let reads = reads(cx.arena, &stages, n);
-    let trig = trig_cache(cx.arena, &stages, n);
+    let trig = trig_cache(cx.arena, &stages, n, &kin.markers);
     Plan {
         stages,
         reads,
         trig,
+    }
+}
+
+impl Plan {
+    /// Re-plans the trig cache so that kernels run after the whole forward sweep (`Final`:
+    /// the markers, the force solve) also find the angles they alone read.
+    pub fn cache_final_reads(&mut self, arena: &mut Arena, n: usize, roots: &[Id]) {
+        self.trig = trig_cache(arena, &self.stages, n, roots);
     }
 }
 
@@ -295,8 +303,8 @@ fn kernel_roots(stage: &Stage) -> [(Phase, Vec<Id>); 2] {
 }
 
 /// The angles worth caching: those whose sine or cosine a kernel reads after the angle's stage
-/// is solved.
-fn trig_cache(arena: &mut Arena, stages: &[Stage], n: usize) -> TrigCache {
+/// is solved, the stages' kernels and the kernels of `final_roots` (run after the sweep).
+fn trig_cache(arena: &mut Arena, stages: &[Stage], n: usize, final_roots: &[Id]) -> TrigCache {
     let mut stage_of = vec![0; n];
     for (s, stage) in stages.iter().enumerate() {
         for c in stage_coordinates(stage) {
@@ -304,20 +312,24 @@ fn trig_cache(arena: &mut Arena, stages: &[Stage], n: usize) -> TrigCache {
         }
     }
     let mut wanted = vec![false; n];
-    for (s, stage) in stages.iter().enumerate() {
-        for (phase, roots) in kernel_roots(stage) {
-            for id in crate::interpret::topological_order(arena, &roots) {
-                if let Node::Call(Func::Sin | Func::Cos, a) = arena.node(id)
-                    && let Node::Var(Var::Q(k)) = arena.node(a)
-                {
-                    let k = k as usize;
-                    let ready = match phase {
-                        Phase::Positions => stage_of[k] < s,
-                        Phase::After => stage_of[k] <= s,
-                        Phase::Final => true,
-                    };
-                    wanted[k] |= ready;
-                }
+    let final_kernels = (stages.len(), (Phase::Final, final_roots.to_vec()));
+    let kernels = stages
+        .iter()
+        .enumerate()
+        .flat_map(|(s, stage)| kernel_roots(stage).map(|k| (s, k)))
+        .chain([final_kernels]);
+    for (s, (phase, roots)) in kernels {
+        for id in crate::interpret::topological_order(arena, &roots) {
+            if let Node::Call(Func::Sin | Func::Cos, a) = arena.node(id)
+                && let Node::Var(Var::Q(k)) = arena.node(a)
+            {
+                let k = k as usize;
+                let ready = match phase {
+                    Phase::Positions => stage_of[k] < s,
+                    Phase::After => stage_of[k] <= s,
+                    Phase::Final => true,
+                };
+                wanted[k] |= ready;
             }
         }
     }
@@ -325,7 +337,7 @@ fn trig_cache(arena: &mut Arena, stages: &[Stage], n: usize) -> TrigCache {
     let nodes: Vec<(Id, Id)> = angles
         .iter()
         .map(|&k| {
-            let q = arena.var(Var::Q(index(k)));
+            let q = arena.var(Var::Q(var_index(k)));
             (arena.sin(q), arena.cos(q))
         })
         .collect();
@@ -465,10 +477,10 @@ impl Planner<'_> {
                 }
                 known[c] = true;
                 done[i] = true;
-                self.map.insert(Var::Q(index(c)), value);
+                self.map.insert(Var::Q(var_index(c)), value);
                 let zero = self.arena.zero();
-                self.map.insert(Var::Qd(index(c)), zero);
-                self.map.insert(Var::Qdd(index(c)), zero);
+                self.map.insert(Var::Qd(var_index(c)), zero);
+                self.map.insert(Var::Qdd(var_index(c)), zero);
                 let rates = self.outputs >= Outputs::Velocities;
                 let accelerations = self.outputs >= Outputs::Accelerations;
                 fixed.push(Assignment {
@@ -513,12 +525,12 @@ impl Planner<'_> {
 
     /// `(q_c = −g/a, a)` if `e = a·q_c + g` with a constant non-zero `a`.
     fn explicit_value(&mut self, e: Id, c: usize) -> Option<(Id, f64)> {
-        let slope = self.d.diff(self.arena, e, Var::Q(index(c)));
+        let slope = self.d.diff(self.arena, e, Var::Q(var_index(c)));
         let a = self.arena.as_const(slope)?;
         if a == 0.0 || !a.is_finite() {
             return None;
         }
-        let zero = HashMap::from([(Var::Q(index(c)), self.arena.zero())]);
+        let zero = HashMap::from([(Var::Q(var_index(c)), self.arena.zero())]);
         let g = self.arena.substitute(e, &zero, &mut HashMap::new());
         Some((self.divide(g, -a), a))
     }
@@ -595,20 +607,20 @@ impl Planner<'_> {
     fn assignment(&mut self, i: usize, c: usize, position: Id, a: f64) -> Assignment {
         let known = self.sample.clone();
         self.sample[c] = self.evaluate(&[position], &known)[0];
-        let position = self.within_stage(Var::Q(index(c)), position);
+        let position = self.within_stage(Var::Q(var_index(c)), position);
         let velocity = (self.outputs >= Outputs::Velocities).then(|| {
             let nu = self.kin.nu.as_ref().map_or(self.arena.zero(), |nu| nu[i]);
             let rhs = self.rate_rhs(nu, i, &[c], Var::Qd);
             let value = self.divide(rhs, a);
-            let value = self.forward(Var::Qd(index(c)), value);
-            self.within_stage(Var::Qd(index(c)), value)
+            let value = self.forward(Var::Qd(var_index(c)), value);
+            self.within_stage(Var::Qd(var_index(c)), value)
         });
         let acceleration = (self.outputs >= Outputs::Accelerations).then(|| {
             let gamma = self.kin.gamma.as_ref().map_or(self.arena.zero(), |g| g[i]);
             let rhs = self.rate_rhs(gamma, i, &[c], Var::Qdd);
             let value = self.divide(rhs, a);
-            let value = self.forward(Var::Qdd(index(c)), value);
-            self.within_stage(Var::Qdd(index(c)), value)
+            let value = self.forward(Var::Qdd(var_index(c)), value);
+            self.within_stage(Var::Qdd(var_index(c)), value)
         });
         Assignment {
             equation: i,
@@ -656,7 +668,7 @@ impl Planner<'_> {
             if own.contains(&k) {
                 continue;
             }
-            let r = self.arena.var(rate(index(k)));
+            let r = self.arena.var(rate(var_index(k)));
             let term = self.arena.mul(value, r);
             rhs = self.arena.sub(rhs, term);
         }
@@ -673,7 +685,7 @@ impl Planner<'_> {
         let mut natural = Vec::new();
         for (r, &i) in equations.iter().enumerate() {
             for (col, &c) in coordinates.iter().enumerate() {
-                let value = self.d.diff(self.arena, phi[i], Var::Q(index(c)));
+                let value = self.d.diff(self.arena, phi[i], Var::Q(var_index(c)));
                 if !self.arena.is_zero(value) {
                     natural.push((r, col, value));
                 }
@@ -753,8 +765,4 @@ fn ranks(permutation: &[usize]) -> Vec<usize> {
         ranks[p] = k;
     }
     ranks
-}
-
-fn index(k: usize) -> u32 {
-    u32::try_from(k).unwrap_or(u32::MAX)
 }

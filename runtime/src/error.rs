@@ -10,6 +10,7 @@ use crate::mechanism::{Mechanism, Storage};
 /// The quantity found to be NaN or infinite.
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Quantity {
     /// The time passed in.
     Time,

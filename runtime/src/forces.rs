@@ -87,6 +87,11 @@ where
     // The multipliers and the archive are borrowed apart from the rest of the workspace, which
     // a block's refactorisation needs.
     let storage = core::mem::take(&mut parts.forces);
+    // The generated workspace sizes the storage for the multipliers and the archive.
+    debug_assert!(
+        storage.len() >= n,
+        "force storage shorter than the multipliers"
+    );
     let result = match storage.len().checked_sub(n) {
         Some(_) => {
             let (lambda, archive) = storage.split_at_mut(n);

@@ -107,6 +107,7 @@ impl core::error::Error for ParameterError<'_> {}
 /// Ordered: each level includes the ones before it.
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[non_exhaustive]
 pub enum Outputs {
     /// Positions q only.
     Positions,

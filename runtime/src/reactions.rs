@@ -37,8 +37,12 @@ pub struct DistanceReaction {
     pub tension: f64,
 }
 
-/// The load the mechanism puts on a ground body through its joints and drivers: what its
-/// mounting must resist.
+/// The load the mechanism puts on a ground body through its joints, its drivers and the
+/// springs anchored to it: what its mounting must resist.
+///
+/// A driver of a point's world `x` or `y` pushes against the world, not against any ground
+/// body: its effort is in no ground load (so the ground loads and the drivers' efforts
+/// together balance the mechanism's weight and loads).
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GroundLoad {

@@ -169,7 +169,8 @@ where
             q: Vector::zeros_generic(dim, nalgebra::U1),
             velocities: Vector::zeros_generic(dim, nalgebra::U1),
             accelerations: Vector::zeros_generic(dim, nalgebra::U1),
-            reactions: Vector::zeros_generic(dim, nalgebra::U1),
+            // NaN until a force solve writes them: a scene without forces has none.
+            reactions: Vector::from_element_generic(dim, nalgebra::U1, f64::NAN),
             markers: mechanism.marker_storage(),
             iterations: 0,
             substeps: 0,

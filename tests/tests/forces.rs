@@ -19,8 +19,8 @@ use mechgen_examples::inverse_dynamics::{MassProperties, seed_reactions};
 use mechgen_examples::scenes::{PistonCrankDynamics, PistonCrankDynamicsForces};
 use mechgen_runtime::nalgebra::DVector;
 use mechgen_runtime::{
-    Dense, Mechanism, Quantity, Simulation, SolveError, Solver, SolverOptions, State, Structured,
-    mechanism,
+    Dense, Forces, Mechanism, Quantity, Simulation, SolveError, Solver, SolverOptions, State,
+    Structured, mechanism,
 };
 use num_dual::{Dual2_64, DualNum, second_derivative};
 
@@ -30,8 +30,8 @@ fn read_scene(file: &str) -> String {
 }
 
 /// Largest difference of each column of `a` and `b` relative to the column's largest magnitude
-/// in `b` (over all rows), the largest over all columns; columns that are zero throughout are
-/// held to an absolute 1e-12 of `floor`.
+/// in `b` (over all rows), the largest over all columns; a column smaller than `floor`
+/// throughout is measured against `floor`.
 fn relative_error(a: &[Vec<f64>], b: &[Vec<f64>], floor: f64) -> f64 {
     let columns = b.first().map_or(0, Vec::len);
     (0..columns)
@@ -458,44 +458,114 @@ fn newton_euler_balances_every_body_of_the_seed() {
     assert_newton_euler(&read_scene("piston_crank_dynamics.mech"), period, 90);
 }
 
-/// Every joint kind, a rotated frame, offset centres of mass, world and body-axis forces, a
-/// torque, a spring-damper, and drivers relative to the frame and between bodies.
-const SINK: &str = "mechanism Sink {
-    param omega = 3.0;
-    ground frame at (0, 0, 0.1);
-    body crank near (4.8, 2.5, 0) mass 1.5 inertia 40 centre (10, 3);
-    body slider near (110, 5, 0.1) mass 0.8 inertia 5 centre (2, -1);
-    body arm near (115, 5, 0.1) mass 0.6 inertia 30 centre (0, 10);
-    joint pivot: revolute(frame @ (5, 2), crank);
-    joint rod: distance(crank @ (30, 0), slider @ (0, 3), 80);
-    joint guide: prismatic(frame @ (0, -10), slider, along (2, 0.3));
-    joint hinge: revolute(slider @ (5, 0), arm);
-    driver spin: relative_angle(frame, crank) = omega * t;
-    driver wave: relative_angle(slider, arm) = 0.3 * sin(5 * t);
-    gravity (0.5, -9.81);
-    load push: force(slider @ (1, 1)) = (3 * sin(t), 2);
-    load thrust: local_force(arm @ (0, 20)) = (0, 4);
-    load brake: torque(crank) = -0.2 * t;
-    load coil: spring(frame @ (50, 40), arm @ (0, 20), stiffness 2, length 30, damping 0.05);
-}";
+/// A scene both as generated code (`mechanism!`) and as `.mech` text for the interpreter.
+macro_rules! twin {
+    ($text:ident, $($scene:tt)*) => {
+        mechanism! { $($scene)* }
+        const $text: &str = stringify!($($scene)*);
+    };
+}
 
-/// A travel driver and an x driver, a damper alone, a frame turned the other way.
-const CARRIAGE: &str = "mechanism Carriage {
-    ground frame at (3, -2, -0.2);
-    body carriage near (3, -2, -0.2) mass 2 inertia 10 centre (1, 0.5);
-    body pendulum near (3, -2, -0.2) mass 0.5 inertia 8 centre (0, -15);
-    joint guide: prismatic(frame, carriage, along (1, 1));
-    joint hinge: revolute(carriage, pendulum);
-    driver stroke: travel(guide) = 20 * sin(2 * t);
-    driver sway: x(pendulum @ (0, -30)) = 3 - 5 * sin(1.5 * t) + 12 * sin(2 * t);
-    gravity (0, -9.81);
-    load drag: spring(frame @ (0, 40), pendulum @ (0, -30), damping 0.3);
-}";
+// Every joint kind, a rotated frame, offset centres of mass, world and body-axis forces, a
+// torque, a spring-damper, and drivers relative to the frame and between bodies.
+twin! {
+    SINK,
+    mechanism Sink {
+        param omega = 3.0;
+        ground frame at (0, 0, 0.1);
+        body crank near (4.8, 2.5, 0) mass 1.5 inertia 40 centre (10, 3);
+        body slider near (110, 5, 0.1) mass 0.8 inertia 5 centre (2, -1);
+        body arm near (115, 5, 0.1) mass 0.6 inertia 30 centre (0, 10);
+        joint pivot: revolute(frame @ (5, 2), crank);
+        joint rod: distance(crank @ (30, 0), slider @ (0, 3), 80);
+        joint guide: prismatic(frame @ (0, -10), slider, along (2, 0.3));
+        joint hinge: revolute(slider @ (5, 0), arm);
+        driver spin: relative_angle(frame, crank) = omega * t;
+        driver wave: relative_angle(slider, arm) = 0.3 * sin(5 * t);
+        gravity (0.5, -9.81);
+        load push: force(slider @ (1, 1)) = (3 * sin(t), 2);
+        load thrust: local_force(arm @ (0, 20)) = (0, 4);
+        load brake: torque(crank) = -0.2 * t;
+        load coil: spring(frame @ (50, 40), arm @ (0, 20), stiffness 2, length 30, damping 0.05);
+    }
+}
+
+// A travel driver and an x driver, a damper alone, a frame turned the other way.
+twin! {
+    CARRIAGE,
+    mechanism Carriage {
+        ground frame at (3, -2, -0.2);
+        body carriage near (3, -2, -0.2) mass 2 inertia 10 centre (1, 0.5);
+        body pendulum near (3, -2, -0.2) mass 0.5 inertia 8 centre (0, -15);
+        joint guide: prismatic(frame, carriage, along (1, 1));
+        joint hinge: revolute(carriage, pendulum);
+        driver stroke: travel(guide) = 20 * sin(2 * t);
+        driver sway: x(pendulum @ (0, -30)) = 3 - 5 * sin(1.5 * t) + 12 * sin(2 * t);
+        gravity (0, -9.81);
+        load drag: spring(frame @ (0, 40), pendulum @ (0, -30), damping 0.3);
+    }
+}
 
 #[test]
 fn newton_euler_balances_every_joint_driver_and_load_kind() {
     assert_newton_euler(SINK, 2.0, 60);
     assert_newton_euler(CARRIAGE, 3.0, 60);
+}
+
+/// The reactions along `steps` steps of a simulation to `t_end`, as rows.
+fn reaction_rows<M: Structured + Forces>(mechanism: M, t_end: f64, steps: usize) -> Vec<Vec<f64>>
+where
+    mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
+{
+    let mut simulation = Simulation::new(Solver::new(mechanism), 0.0).expect("assembles");
+    let mut rows = Vec::new();
+    simulation
+        .run(t_end, steps, |state| {
+            rows.push(state.constraint_forces().as_slice().to_vec());
+        })
+        .expect("solves");
+    rows
+}
+
+#[test]
+fn generated_force_solve_matches_the_interpreter_across_blocks() {
+    // Carriage solves in two blocks, so its force solve walks the archive of the first
+    // block's factors; Sink has every joint kind.
+    let interpreted = |text: &str| {
+        Interpreted::new(&mechgen::compile_str(text).unwrap_or_else(|e| panic!("{e}")))
+    };
+    let error = relative_error(
+        &reaction_rows(Sink::default(), 2.0, 60),
+        &reaction_rows(interpreted(SINK), 2.0, 60),
+        1.0,
+    );
+    assert!(
+        error <= 1e-11,
+        "Sink: generated vs interpreted reactions {error:e}"
+    );
+    let error = relative_error(
+        &reaction_rows(Carriage::default(), 3.0, 60),
+        &reaction_rows(interpreted(CARRIAGE), 3.0, 60),
+        1.0,
+    );
+    assert!(
+        error <= 1e-11,
+        "Carriage: generated vs interpreted reactions {error:e}"
+    );
+    let blocks = |stages: usize| {
+        (0..stages)
+            .filter(|&s| {
+                matches!(
+                    Carriage::default().stage(s),
+                    Some(mechgen_runtime::Stage::Block(_))
+                )
+            })
+            .count()
+    };
+    assert!(
+        blocks(Carriage::default().stage_count()) >= 2,
+        "Carriage has one block only"
+    );
 }
 
 mechanism! {
@@ -646,13 +716,22 @@ fn spring_damper_forces_match_hand_derivation() {
             assert!((r.guide.normal - 3.0 * -9.81).abs() <= 1e-12);
             assert!(r.guide.torque.abs() <= 1e-12);
             assert!((r.frame.fy - 3.0 * -9.81).abs() <= 1e-12);
+            // The spring pulls the frame toward the slider; the x driver pushes against the
+            // world, not the frame.
+            let tension = 500.0 * (x - 0.8) + 4.0 * v;
+            assert!(
+                (r.frame.fx - tension).abs() <= 1e-10 * 300.0,
+                "{} vs {tension}",
+                r.frame.fx
+            );
         })
         .expect("solves");
 }
 
 #[test]
 fn non_finite_loads_are_typed_errors_naming_the_forces() {
-    // A force that becomes NaN past t = 1, and a spring whose ends meet.
+    // A force that becomes NaN past t = 1, and a spring of non-zero free length whose ends
+    // meet (its direction, and so its force, is undefined there).
     let scene = |load: &str| {
         let source = format!(
             "mechanism M {{
@@ -682,5 +761,34 @@ fn non_finite_loads_are_typed_errors_naming_the_forces() {
             }) => assert_eq!(t, time),
             other => panic!("{load}: expected a non-finite load, got {other:?}"),
         }
+    }
+}
+
+#[test]
+fn a_zero_length_spring_stays_finite_where_its_ends_meet() {
+    // Its force, k d, is defined everywhere: through the meeting point at t = 1 the driver
+    // holds it, never a NaN.
+    let source = "mechanism M {
+        ground frame at (0, 0, 0);
+        body slider near (1, 0, 0) mass 1;
+        joint guide: prismatic(frame, slider, along (1, 0));
+        driver stroke: x(slider) = 1 - t;
+        load coil: spring(frame, slider, stiffness 3, length 0);
+    }";
+    let mut solver = Solver::new(Interpreted::new(
+        &mechgen::compile_str(source).unwrap_or_else(|e| panic!("{e}")),
+    ));
+    for time in [0.5, 1.0, 1.5] {
+        let guess = DVector::from_vec(vec![0.0, 0.0, 0.0, 1.0 - time, 0.0, 0.0]);
+        let state = solver
+            .solve(time, &guess)
+            .unwrap_or_else(|e| panic!("t = {time}: {e}"));
+        // The slider moves at constant speed: the driver balances the spring, 3 (1 − t) toward
+        // the frame, so its effort along x is +3 (1 − t) (`x = 1 − t`: Φ = x − (1 − t)).
+        let effort = state.constraint_forces()[5];
+        assert!(
+            (effort - 3.0 * (1.0 - time)).abs() < 1e-12,
+            "t = {time}: effort {effort}"
+        );
     }
 }

@@ -310,14 +310,14 @@ impl Kernels<'_> {
                 let call = kernel.call();
                 let arm = quote! {
                     let #some(out) = out.first_chunk_mut::<#len>() else {
+                        out.fill(f64::NAN);
                         return;
                     };
                     #call;
                 };
                 self.force_rhs.push(s, arm, &kernel.arguments);
             }
-            // The force plan follows the kinematic plan stage for stage.
-            _ => {}
+            _ => unreachable!("the force plan follows the kinematic plan stage for stage"),
         }
     }
 }

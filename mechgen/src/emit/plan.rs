@@ -330,10 +330,15 @@ impl Dispatch {
             }
         };
         let stage = named("stage");
+        // A view that does not fit leaves no stale output behind: the outputs read NaN.
+        let poisoned = params
+            .iter()
+            .filter(|(p, ty)| self.reads.contains(p) && ty.to_string().contains("mut"))
+            .map(|(p, _)| format_ident!("{}", p));
         let early = if result.is_some() {
             quote!(return ::core::result::Result::Err(0))
         } else {
-            quote!(return)
+            quote!(#(#poisoned.fill(f64::NAN);)* return)
         };
         let conversions: Vec<TokenStream> = views
             .iter()
@@ -771,6 +776,8 @@ impl<'p> Kernels<'p> {
                 let (#some(phi), #some(values)) =
                     (phi.first_chunk_mut::<#n>(), values.first_chunk_mut::<#slots>())
                 else {
+                    phi.fill(f64::NAN);
+                    values.fill(f64::NAN);
                     return;
                 };
                 #call;
@@ -812,6 +819,7 @@ impl<'p> Kernels<'p> {
             let call = kernel.call();
             let arm = quote! {
                 let #some(out) = out.first_chunk_mut::<#n>() else {
+                    out.fill(f64::NAN);
                     return;
                 };
                 #call;
@@ -851,6 +859,7 @@ impl<'p> Kernels<'p> {
                         let (#some(values), #some(x)) =
                             (values.first_chunk::<#slots>(), x.first_chunk_mut::<#n>())
                         else {
+                            x.fill(f64::NAN);
                             return;
                         };
                         Self::#function(values, x);
