@@ -377,8 +377,8 @@ impl FourBar {
         let (sin2, cos2) = th2.sin_cos();
         let (ax, ay) = (cos2 * self.crank, sin2 * self.crank);
         let (bx, by) = self.pin_b_generic(t);
-        let th3 = (by - ay).atan2(bx - ax);
-        let th4 = by.atan2(bx - self.ground);
+        let th3 = angle_of(by - ay, bx - ax);
+        let th4 = angle_of(by, bx - self.ground);
         [
             zero,
             zero,
@@ -429,6 +429,22 @@ pub fn seed_piston_crank(t: f64) -> Kinematics<15> {
 /// Exact `q`, `q̇`, `q̈` of the default crank-rocker four-bar ([`FourBar::default`]) at time `t`.
 pub fn four_bar(t: f64) -> Kinematics<12> {
     FourBar::default().kinematics(t)
+}
+
+/// `atan2(y, x)` for dual numbers, exact in its derivatives everywhere: num-dual's `atan2`
+/// divides by `x` and loses its derivatives where `x` crosses zero (a rocker standing
+/// vertical), so there the angle is measured from the y axis instead.
+fn angle_of<D: DualNum<Primitive = f64> + Copy>(y: D, x: D) -> D {
+    if x.re().abs() >= y.re().abs() {
+        y.atan2(x)
+    } else {
+        let turned = (-x).atan2(y) + core::f64::consts::FRAC_PI_2;
+        if turned.re() > core::f64::consts::PI {
+            turned - core::f64::consts::TAU
+        } else {
+            turned
+        }
+    }
 }
 
 #[cfg(test)]

@@ -1,6 +1,7 @@
 //! The example scenes, declared with `mechanism!`. Each has a `.mech` twin in `scenes/` for the
 //! CLI; a test holds the two to the same tokens. `PistonCrankDynamics` is the seed with mass
-//! properties and gravity: the force solve's example.
+//! properties and gravity: the force solve's example; `Hoeken` and `Planetary` show markers
+//! and gears.
 
 use mechgen_runtime::mechanism;
 
@@ -124,5 +125,79 @@ mechanism! {
         driver pose: angle(crank) = crank_angle;
 
         outputs positions;
+    }
+}
+
+mechanism! {
+    /// Hoeken's straight-line linkage: a crank-rocker four-bar (crank 1, frame 2, rocker 2.5,
+    /// coupler 2.5) whose coupler, extended to 5, carries a tracer (lengths in crank lengths, s).
+    ///
+    /// Over the half turn of the crank from 90° to 270° the tracer runs nearly straight along
+    /// y = 4, from x = 4 back to x = 0, at nearly constant speed.
+    pub mechanism Hoeken {
+        /// Crank speed (rad/s).
+        param omega = 1.0;
+
+        /// Frame, with the crank pivot at its origin and the rocker pivot at (2, 0).
+        ground frame at (0, 0, 0);
+        /// Crank, pivoting at its reference point.
+        body crank near (0, 0, 0);
+        /// Coupler, with its reference point at the crank pin.
+        body coupler near (1, 0, 1.4);
+        /// Rocker, pivoting at its reference point.
+        body rocker near (2, 0, 1.8);
+
+        joint crank_pivot: revolute(frame, crank);
+        joint crank_pin: revolute(crank @ (1, 0), coupler);
+        joint rocker_pin: revolute(coupler @ (2.5, 0), rocker @ (2.5, 0));
+        joint rocker_pivot: revolute(rocker, frame @ (2, 0));
+
+        driver crank_angle: angle(crank) = omega * t;
+
+        /// The tracer at the end of the coupler's extension.
+        marker tracer: coupler @ (5, 0);
+        /// The transmission angle at the rocker pin: the rocker's angle less the coupler's.
+        marker transmission: angle(coupler, rocker);
+
+        /// Open, not crossed: at the rocker pin, the rocker (towards its pivot) lies anticlockwise of
+        /// the coupler (towards the crank pin).
+        branch open_assembly: cross(coupler @ (2.5, 0) -> coupler, rocker @ (2.5, 0) -> rocker) > 0;
+    }
+}
+
+mechanism! {
+    /// A planetary gear set with its ring fixed in the frame: the sun (24 teeth) drives, one planet
+    /// (24) rolls inside the ring (72) on the carrier, which is the output (module 2: pitch radii
+    /// 24, 24 and 72 mm; mm, rad, s). More planets would add only redundant constraints.
+    ///
+    /// Willis: (ω_sun − ω_carrier) / (ω_ring − ω_carrier) = −72 / 24, so with the ring fixed the
+    /// carrier turns at a quarter of the sun's speed.
+    pub mechanism Planetary {
+        /// Sun speed (rad/s).
+        param omega = 10.0;
+
+        /// Frame, carrying the ring gear; every axle is at its origin.
+        ground frame at (0, 0, 0);
+        /// Sun gear, on the frame's axis.
+        body sun near (0, 0, 0);
+        /// Carrier, on the frame's axis, with the planet's axle at (48, 0).
+        body carrier near (0, 0, 0);
+        /// Planet gear, centred on its reference point.
+        body planet near (48, 0, 0);
+
+        joint sun_axle: revolute(frame, sun);
+        joint carrier_axle: revolute(frame, carrier);
+        joint planet_axle: revolute(carrier @ (48, 0), planet);
+        /// External mesh: relative to the carrier the planet turns against the sun, 24 : 24.
+        joint sun_mesh: gear(sun, planet, ratio -24 / 24, carrier carrier);
+        /// Internal mesh with the ring (the frame): the same sense relative to the carrier, 24 : 72.
+        joint ring_mesh: gear(planet, frame, ratio 24 / 72, carrier carrier);
+
+        driver input: angle(sun) = omega * t;
+
+        /// A point of the planet's pitch circle: it rolls along the ring, tracing a hypocycloid.
+        marker tooth: planet @ (24, 0);
+        /// The carrier's turn, the gear set's output.
+        marker output: angle(frame, carrier);
     }
 }

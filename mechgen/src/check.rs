@@ -574,6 +574,10 @@ impl Checker {
     /// Reports a constant expression that folded to NaN or infinity (the arena keeps such a
     /// node unfolded): `result` computed from constant `operands` must be a constant.
     fn check_folded(&mut self, span: Span, result: Id, operands: &[Id], hint: &str) {
+        // The naive baseline folds nothing: the same scene was checked folded.
+        if !self.arena.simplifies() {
+            return;
+        }
         let constant = |id: &Id| self.arena.as_const(*id).is_some();
         if operands.iter().all(constant) && !constant(&result) {
             self.errors.push(

@@ -330,7 +330,7 @@ fn vector(input: ParseStream) -> syn::Result<[PointRef; 2]> {
 /// The joint kinds and how each is written, for error messages.
 const JOINT_KINDS: &str = "`revolute(a @ (x, y), b @ (x, y))`, `prismatic(a, b, along (ux, uy))`, \
      `distance(a, b, length)`, `slot(a @ (x, y), b @ (x, y), along (ux, uy))`, \
-     `weld(a @ (x, y), b @ (x, y))`, `gear(a, b, ratio k, carrier c)` or \
+     `weld(a @ (x, y), b @ (x, y))`, `gear(a, b, ratio k[, carrier c])` or \
      `rack(prismatic_joint, pinion, ratio r)`";
 
 fn joint_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, JointKind)> {

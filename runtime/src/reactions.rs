@@ -40,9 +40,9 @@ pub struct DistanceReaction {
 /// The load the mechanism puts on a ground body through its joints, its drivers and the
 /// springs anchored to it: what its mounting must resist.
 ///
-/// A driver of a point's world `x` or `y` pushes against the world, not against any ground
-/// body: its effort is in no ground load (so the ground loads and the drivers' efforts
-/// together balance the mechanism's weight and loads).
+/// A driver of a body's `angle` or of a point's world `x` or `y` pushes against the world, not
+/// against any ground body: its effort is in no ground load (so the ground loads and those
+/// drivers' efforts together balance the mechanism's weight and loads).
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GroundLoad {

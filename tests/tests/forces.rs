@@ -22,6 +22,7 @@ use mechgen_runtime::{
     Dense, Forces, Mechanism, Quantity, Simulation, SolveError, Solver, SolverOptions, State,
     Structured, mechanism,
 };
+use mechgen_tests::twin;
 use num_dual::{Dual2_64, DualNum, second_derivative};
 
 fn read_scene(file: &str) -> String {
@@ -456,14 +457,6 @@ fn assert_newton_euler(source: &str, t_end: f64, steps: usize) {
 fn newton_euler_balances_every_body_of_the_seed() {
     let period = SeedMotion::default().period();
     assert_newton_euler(&read_scene("piston_crank_dynamics.mech"), period, 90);
-}
-
-/// A scene both as generated code (`mechanism!`) and as `.mech` text for the interpreter.
-macro_rules! twin {
-    ($text:ident, $($scene:tt)*) => {
-        mechanism! { $($scene)* }
-        const $text: &str = stringify!($($scene)*);
-    };
 }
 
 // Every joint kind, a rotated frame, offset centres of mass, world and body-axis forces, a

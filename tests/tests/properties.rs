@@ -1,11 +1,43 @@
 //! Property tests over random states: the generated Jacobian against central differences of
-//! the generated Φ, and generated code against the interpreter on the same IR (Φ, Φ_q, ν, γ).
+//! the generated Φ, ν and γ against differences of Φ along the motion, and generated code
+//! against the interpreter on the same IR (Φ, Φ_q, ν, γ); for the example scenes and for a
+//! scene using every joint, driver, function and motion law of the library.
 
 use mechgen_cli::Interpreted;
 use mechgen_examples::scenes::{FourBar, PistonCrank};
 use mechgen_runtime::nalgebra::{DMatrix, DVector, Dyn};
 use mechgen_runtime::{Accelerations, Matrix, Mechanism, Vector};
+use mechgen_tests::twin;
 use proptest::prelude::*;
+
+twin! {
+    LIBRARY,
+    mechanism Library {
+        param ratio = -2.0;
+        ground frame at (0, 0, 0.1);
+        body wheel near (0, 0, 0);
+        body gear near (3, 0, 0);
+        body slider near (0, 0, 0);
+        body rocker near (5, 5, 0);
+        body arm near (6, 5, 0.5);
+        body lever near (-5, 0, 0);
+        body pointer near (0, -5, 0);
+        joint hub: revolute(frame, wheel);
+        joint axle: revolute(frame @ (3, 0), gear);
+        joint mesh: gear(wheel, gear, ratio ratio, phase 10deg);
+        joint rail: prismatic(frame, slider, along (1, 0));
+        joint teeth: rack(rail, wheel, ratio 0.5);
+        joint pivot: revolute(frame @ (5, 5), rocker);
+        joint pin: slot(rocker, slider @ (0, 1), along (0, 1));
+        joint fixed: weld(rocker @ (1, 0), arm, angle 30deg);
+        joint fulcrum: revolute(frame @ (-5, 0), lever);
+        joint needle: revolute(frame @ (0, -5), pointer);
+        driver spin: angle(wheel) = spline(t, (0, 0), (0.4, 0.3), (0.8, 0.2)) + cycloidal(t);
+        driver ram: distance(lever @ (2, 0), arm @ (0, 1)) = 3 + 0.1 * poly345(t) + (1 + t)^1.5;
+        driver sweep: slide(slider, pointer @ (1, 0), along (1, 0.2))
+            = atan2(t, 1) + abs(t - 0.5) + min(t, 0.3) + max(t, 0.7) + asin(t) + acos(t) + pi / 10;
+    }
+}
 
 fn interpreted(file: &str) -> Interpreted {
     let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
@@ -132,8 +164,95 @@ where
     Ok(())
 }
 
+/// ν = −Φ_t and γ = −d²Φ/ds² along the straight path (q + s q̇, t + s), by central
+/// differences of the generated Φ: their truncation error is O(h²) of the terms' scale (1e-5
+/// of it for h = 1e-4) and their round-off a few ε/h² of Φ's scale (the positions' magnitude).
+fn rates_match_differences<M>(
+    mechanism: &M,
+    q: &[f64],
+    qd: &[f64],
+    t: f64,
+) -> Result<(), TestCaseError>
+where
+    M: Accelerations,
+    mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
+{
+    let dim = mechanism.dim();
+    let col = mechgen_runtime::nalgebra::Const::<1>;
+    let vector = |values: &[f64]| {
+        let mut v = Vector::<M::Dim>::zeros_generic(dim, col);
+        v.as_mut_slice().copy_from_slice(values);
+        v
+    };
+    let (qv, qdv) = (vector(q), vector(qd));
+    let h = 1e-4;
+    let phi = |s: f64, along: bool| {
+        let shifted = if along { &qv + &qdv * s } else { qv.clone() };
+        let mut out = Vector::<M::Dim>::zeros_generic(dim, col);
+        mechanism.phi(&shifted, t + s, &mut out);
+        out
+    };
+    let (mut nu, mut gamma) = (vector(q), vector(q));
+    mechanism.nu(&qv, t, &mut nu);
+    mechanism.gamma(&qv, &qdv, t, &mut gamma);
+    let nu_fd = (phi(h, false) - phi(-h, false)) / (-2.0 * h);
+    let gamma_fd = (phi(h, true) - phi(0.0, true) * 2.0 + phi(-h, true)) / (-h * h);
+    let scale_of = |v: &Vector<M::Dim>| v.amax().max(1.0);
+    let phi_scale = phi(0.0, true)
+        .amax()
+        .max(q.iter().fold(1.0f64, |m, x| m.max(x.abs())));
+    let nu_error = (&nu - &nu_fd).amax();
+    prop_assert!(
+        nu_error <= 1e-6 * scale_of(&nu).max(phi_scale),
+        "nu: {nu_error} at scale {}",
+        scale_of(&nu)
+    );
+    let gamma_error = (&gamma - &gamma_fd).amax();
+    prop_assert!(
+        gamma_error <= 1e-5 * scale_of(&gamma) + 16.0 * f64::EPSILON * phi_scale / (h * h),
+        "gamma: {gamma_error} at scale {}",
+        scale_of(&gamma)
+    );
+    Ok(())
+}
+
+/// Random states for the library scene: moderate positions and rates, t inside the rise laws'
+/// interval and the domain of `asin` and `acos`, and away from the kinks of `abs`, `min` and
+/// `max` (at 0.3, 0.5, 0.7), where differences straddle two slopes.
+fn library_states() -> impl Strategy<Value = (Vec<f64>, Vec<f64>, f64)> {
+    (
+        proptest::collection::vec(-6.0..6.0f64, 24),
+        proptest::collection::vec(-3.0..3.0f64, 24),
+        (0.01..0.9f64).prop_filter("away from a kink", |t| {
+            [0.3, 0.5, 0.7].iter().all(|k| (t - k).abs() > 1e-3)
+        }),
+    )
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(200))]
+
+    #[test]
+    fn library_jacobian_matches_central_differences((q, _, t) in library_states()) {
+        jacobian_matches_differences(&Library::default(), &q, t)?;
+    }
+
+    #[test]
+    fn library_rates_match_differences_along_the_motion((q, qd, t) in library_states()) {
+        rates_match_differences(&Library::default(), &q, &qd, t)?;
+    }
+
+    #[test]
+    fn library_generated_and_interpreted_agree((q, qd, t) in library_states()) {
+        let scene = mechgen::compile_str(LIBRARY).unwrap_or_else(|e| panic!("{e}"));
+        agree(&Library::default(), &Interpreted::new(&scene), &q, &qd, t)?;
+    }
+
+    #[test]
+    fn seed_rates_match_differences_along_the_motion((q, qd, t) in states(15)) {
+        let qd: Vec<f64> = qd.iter().map(|v| v * 1e-3).collect();
+        rates_match_differences(&PistonCrank::default(), &q, &qd, t)?;
+    }
 
     #[test]
     fn seed_jacobian_matches_central_differences((q, _, t) in states(15)) {

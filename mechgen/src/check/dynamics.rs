@@ -234,14 +234,16 @@ impl Checker {
                  force(body @ (x, y)) = (fx, fy);`)",
             );
         }
-        for body in &spec.bodies {
-            if FORCE_ACCESSORS.iter().any(|a| body.name == a) {
+        // Bodies and markers both get accessors on the state.
+        let names = (spec.bodies.iter().map(|b| (&b.name, "body")))
+            .chain(spec.markers.iter().map(|m| (&m.name, "marker")));
+        for (name, what) in names {
+            if FORCE_ACCESSORS.iter().any(|a| name == a) {
                 self.errors.push(
-                    body.name.span(),
+                    name.span(),
                     format!(
-                        "a scene that computes forces generates `state.{0}()`, which a body \
-                         named `{0}` would make ambiguous; rename the body",
-                        body.name
+                        "a scene that computes forces generates `state.{name}()`, which a \
+                         {what} named `{name}` would make ambiguous; rename the {what}"
                     ),
                 );
             }

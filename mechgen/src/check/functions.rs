@@ -190,13 +190,14 @@ impl Checker {
                 );
                 return self.arena.zero();
             };
-            let knot_id = self.lower_with(knot, false, false);
+            // Parameters are let through here so that the message below names the rule.
+            let knot_id = self.lower_with(knot, true, false);
             match self.arena.as_const(knot_id) {
                 Some(k) => knots.push(k),
                 None => {
                     self.errors.push(
                         knot.span,
-                        "a spline's x values must be constant numbers (they fix its knots); its \\
+                        "a spline's x values must be constant numbers (they fix its knots); its \
                          y values may use parameters",
                     );
                     return self.arena.zero();

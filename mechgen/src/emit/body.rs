@@ -597,6 +597,15 @@ pub fn f64_literal(value: f64) -> TokenStream {
     let literal: Literal = text
         .parse()
         .unwrap_or_else(|_| Literal::f64_unsuffixed(magnitude));
+    // A folded `pi` or `2 * pi` written out would trip clippy's `approx_constant` in the
+    // user's crate: the constants are named instead.
+    let literal = match named_constant(magnitude) {
+        Some(name) => {
+            let name = quote::format_ident!("{}", name);
+            quote!(::core::f64::consts::#name)
+        }
+        None => quote!(#literal),
+    };
     if value.is_sign_negative() {
         quote!(-#literal)
     } else {
@@ -604,9 +613,48 @@ pub fn f64_literal(value: f64) -> TokenStream {
     }
 }
 
+/// The name of the `core::f64::consts` constant equal to `value`, if any (those clippy's
+/// `approx_constant` recognises).
+fn named_constant(value: f64) -> Option<&'static str> {
+    use core::f64::consts as c;
+    [
+        (c::E, "E"),
+        (c::FRAC_1_PI, "FRAC_1_PI"),
+        (c::FRAC_1_SQRT_2, "FRAC_1_SQRT_2"),
+        (c::FRAC_2_PI, "FRAC_2_PI"),
+        (c::FRAC_2_SQRT_PI, "FRAC_2_SQRT_PI"),
+        (c::FRAC_PI_2, "FRAC_PI_2"),
+        (c::FRAC_PI_3, "FRAC_PI_3"),
+        (c::FRAC_PI_4, "FRAC_PI_4"),
+        (c::FRAC_PI_6, "FRAC_PI_6"),
+        (c::FRAC_PI_8, "FRAC_PI_8"),
+        (c::LN_10, "LN_10"),
+        (c::LN_2, "LN_2"),
+        (c::LOG10_E, "LOG10_E"),
+        (c::LOG2_E, "LOG2_E"),
+        (c::LOG2_10, "LOG2_10"),
+        (c::LOG10_2, "LOG10_2"),
+        (c::PI, "PI"),
+        (c::SQRT_2, "SQRT_2"),
+        (c::TAU, "TAU"),
+    ]
+    .into_iter()
+    .find(|&(constant, _)| constant == value)
+    .map(|(_, name)| name)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn named_constants_are_emitted_by_name() {
+        assert_eq!(
+            f64_literal(-std::f64::consts::TAU).to_string(),
+            "- :: core :: f64 :: consts :: TAU"
+        );
+        assert_eq!(f64_literal(3.0).to_string(), "3.0");
+    }
 
     #[test]
     fn literals_round_trip() {
