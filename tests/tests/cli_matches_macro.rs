@@ -2,7 +2,7 @@
 //! scene compiled by `mechanism!` (generated code + the same solver): equal to round-off, the
 //! force solve's reactions included.
 
-use mechgen_examples::scenes::{FourBar, PistonCrank, PistonCrankDynamics};
+use mechgen_examples::scenes::{FourBar, Hoeken, PistonCrank, PistonCrankDynamics};
 use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{Simulation, Solver, Structured, write_csv_header};
 
@@ -119,4 +119,37 @@ fn four_bar_cli_matches_generated_code() {
     let cli = cli_solve("four_bar.mech", period, 180);
     let generated = macro_solve(FourBar::default(), period, 180);
     assert_round_off_equal(&cli, &generated, 3);
+}
+
+#[test]
+fn hoeken_markers_cli_matches_generated_code() {
+    // Markers follow the kinematics: the tracer's position and rates, then the transmission
+    // angle's. Lengths are crank lengths (O(1)), so each column is held to 1e-12 of its
+    // largest magnitude or of 1.
+    let period = 2.0 * std::f64::consts::PI;
+    let cli = cli_solve("hoeken.mech", period, 120);
+    let generated = macro_solve(Hoeken::default(), period, 120);
+    let (cli_header, cli_rows) = parse(&cli);
+    let (gen_header, gen_rows) = parse(&generated);
+    assert_eq!(cli_header, gen_header);
+    let markers = [
+        "tracer.x",
+        "tracer.y",
+        "tracer.x_dot",
+        "tracer.y_dot",
+        "tracer.x_ddot",
+        "tracer.y_ddot",
+        "transmission.angle",
+        "transmission.angle_dot",
+        "transmission.angle_ddot",
+    ];
+    assert_eq!(cli_header[cli_header.len() - markers.len()..], markers);
+    for (column, name) in cli_header.iter().enumerate() {
+        let scale = gen_rows.iter().fold(1.0f64, |m, r| m.max(r[column].abs()));
+        let worst = cli_rows
+            .iter()
+            .zip(&gen_rows)
+            .fold(0.0f64, |m, (a, b)| m.max((a[column] - b[column]).abs()));
+        assert!(worst <= 1e-12 * scale, "{name}: differs by {worst:e}");
+    }
 }
