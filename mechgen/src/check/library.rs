@@ -24,9 +24,7 @@ impl Checker {
                 axis,
                 axis_span,
             } => {
-                let points = self.two_points(a, b, "joint");
-                let axis = self.unit_axis(axis, *axis_span)?;
-                let (a, b) = points?;
+                let (a, b, axis) = self.points_along(a, b, axis, *axis_span, "joint")?;
                 self.prismatic.insert(name.to_string(), (a, b, axis));
                 Some(ConstraintKind::Prismatic { a, b, axis })
             }
@@ -36,9 +34,7 @@ impl Checker {
                 axis,
                 axis_span,
             } => {
-                let points = self.two_points(a, b, "joint");
-                let axis = self.unit_axis(axis, *axis_span)?;
-                let (a, b) = points?;
+                let (a, b, axis) = self.points_along(a, b, axis, *axis_span, "joint")?;
                 Some(ConstraintKind::Slot { a, b, axis })
             }
             JointKind::Distance { a, b, length } => {
@@ -199,9 +195,7 @@ impl Checker {
                 axis,
                 axis_span,
             } => {
-                let points = self.two_points(a, b, "driver");
-                let axis = self.unit_axis(axis, *axis_span)?;
-                let (a, b) = points?;
+                let (a, b, axis) = self.points_along(a, b, axis, *axis_span, "driver")?;
                 Some(Driven::Travel { a, b, axis })
             }
             DriverKind::Distance(a, b) => {
@@ -262,6 +256,22 @@ impl Checker {
             );
         }
         found
+    }
+
+    /// [`Self::two_points`] and a unit axis along which they move (`prismatic`, `slot`,
+    /// `slide`): every error of both reported.
+    fn points_along(
+        &mut self,
+        a: &PointRef,
+        b: &PointRef,
+        axis: &[Expr; 2],
+        axis_span: Span,
+        what: &str,
+    ) -> Option<(Point, Point, [Id; 2])> {
+        let points = self.two_points(a, b, what);
+        let axis = self.unit_axis(axis, axis_span)?;
+        let (a, b) = points?;
+        Some((a, b, axis))
     }
 
     /// Two points on different bodies, not both fixed; `what` (`joint`, `driver`) names the
