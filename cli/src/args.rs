@@ -7,6 +7,8 @@ use std::path::PathBuf;
 
 use clap::{ArgGroup, Args, CommandFactory, Parser, Subcommand};
 
+use mechgen::limits::Limits;
+
 use crate::solve::Format;
 
 /// Exit status text shared by every help page.
@@ -38,6 +40,13 @@ Every time is written back in the `t` column in shortest round-trip form, bit fo
 struct Cli {
     #[command(subcommand)]
     command: Sub,
+    /// Read scenes up to BYTES long (default 8 MiB: larger files are refused before they are
+    /// read)
+    #[arg(long, global = true, value_name = "BYTES", value_parser = clap::value_parser!(u64).range(1..))]
+    max_file_size: Option<u64>,
+    /// Read scenes of up to N statements (default 100000)
+    #[arg(long, global = true, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    max_statements: Option<u64>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -123,11 +132,15 @@ pub enum Command {
     Expand {
         /// The scene.
         input: Input,
+        /// The limits it is read within.
+        limits: Limits,
     },
     /// Describe a scene.
     Check {
         /// The scene.
         input: Input,
+        /// The limits it is read within.
+        limits: Limits,
         /// Also print operation counts of the generated functions.
         stats: bool,
         /// Text report or JSON.
@@ -191,6 +204,8 @@ pub enum Times {
 pub struct SolveArgs {
     /// The scene.
     pub input: Input,
+    /// The limits it is read within.
+    pub limits: Limits,
     /// The sample times.
     pub times: Times,
     /// Parameter overrides in command-line order: names are checked against the scene later,
@@ -212,19 +227,31 @@ pub struct SolveArgs {
 pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<Command, clap::Error> {
     let program = std::iter::once(OsString::from("mechgen"));
     let cli = Cli::try_parse_from(program.chain(args))?;
+    let defaults = Limits::default();
+    let limit = |value: Option<u64>, default: usize| {
+        value.map_or(default, |v| usize::try_from(v).unwrap_or(usize::MAX))
+    };
+    let limits = Limits {
+        bytes: limit(cli.max_file_size, defaults.bytes),
+        statements: limit(cli.max_statements, defaults.statements),
+    };
     Ok(match cli.command {
-        Sub::Expand { file } => Command::Expand { input: input(file) },
+        Sub::Expand { file } => Command::Expand {
+            input: input(file),
+            limits,
+        },
         Sub::Check {
             file,
             stats,
             format,
         } => Command::Check {
             input: input(file),
+            limits,
             stats,
             format,
         },
         Sub::Completions { shell } => Command::Completions(shell),
-        Sub::Solve(flags) => Command::Solve(solve_args(flags)?),
+        Sub::Solve(flags) => Command::Solve(solve_args(flags, limits)?),
     })
 }
 
@@ -241,7 +268,7 @@ fn input(file: PathBuf) -> Input {
     }
 }
 
-fn solve_args(flags: SolveFlags) -> Result<SolveArgs, clap::Error> {
+fn solve_args(flags: SolveFlags, limits: Limits) -> Result<SolveArgs, clap::Error> {
     let times = match (flags.t_end, flags.steps, flags.times) {
         (Some(t_end), Some(steps), _) => {
             if t_end == flags.t0 {
@@ -279,6 +306,7 @@ fn solve_args(flags: SolveFlags) -> Result<SolveArgs, clap::Error> {
     };
     Ok(SolveArgs {
         input: input(flags.file),
+        limits,
         times,
         sets: flags.sets,
         out,
@@ -401,6 +429,7 @@ mod tests {
         ]);
         let expected = SolveArgs {
             input: Input::File("s.mech".into()),
+            limits: Limits::default(),
             times: Times::Equal {
                 t0: -0.5,
                 t_end: 0.5,

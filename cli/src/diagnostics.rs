@@ -3,6 +3,7 @@
 
 use core::fmt::Write;
 
+use mechgen::source::Locations;
 use proc_macro2::{LineColumn, Span};
 
 /// proc-macro2's lexer error carries no hint; this one says what usually causes it.
@@ -19,8 +20,9 @@ const LEX_HINT: &str = "cannot split the file into tokens here: look for an unba
 /// Renders every error of `errors` (one block each) for the file `name` with contents `source`,
 /// followed by a one-line summary.
 ///
-/// The spans must come from parsing `source` in this process (the CLI parses each file once).
-pub fn render(name: &str, source: &str, errors: &mechgen::Errors) -> String {
+/// The spans must come from reading `source` in this process with [`mechgen::source::read`],
+/// whose `locations` place them in the text.
+pub fn render(name: &str, source: &str, locations: &Locations, errors: &mechgen::Errors) -> String {
     let mut out = String::new();
     let mut count = 0usize;
     for error in errors.iter() {
@@ -36,7 +38,7 @@ pub fn render(name: &str, source: &str, errors: &mechgen::Errors) -> String {
             } else {
                 message
             };
-            block(&mut out, name, source, single.span(), &message);
+            block(&mut out, name, source, locations, single.span(), &message);
         }
     }
     if count > MAX_SHOWN {
@@ -51,8 +53,15 @@ pub fn render(name: &str, source: &str, errors: &mechgen::Errors) -> String {
     out
 }
 
-fn block(out: &mut String, name: &str, source: &str, span: Span, message: &str) {
-    let Some((start, end)) = location(source, span) else {
+fn block(
+    out: &mut String,
+    name: &str,
+    source: &str,
+    locations: &Locations,
+    span: Span,
+    message: &str,
+) {
+    let Some((start, end)) = location(source, locations, span) else {
         let _ = writeln!(out, "{name}: error: {message}\n");
         return;
     };
@@ -112,18 +121,28 @@ fn window(line: &str, column: usize, width: usize) -> (String, usize, usize) {
 }
 
 /// Start (1-based line, 0-based character column) and, if known, end of `span` in `source`.
-fn location(source: &str, span: Span) -> Option<(LineColumn, Option<LineColumn>)> {
+fn location(
+    source: &str,
+    locations: &Locations,
+    span: Span,
+) -> Option<(LineColumn, Option<LineColumn>)> {
     // Only call-site spans have no source text; syn uses them for "unexpected end of input",
     // which is best shown at the end of the file.
     if span.source_text().is_none() {
         return Some((end_of_file(source), None));
     }
-    let start = span.start();
+    // The text was lexed in chunks: place the chunk-relative position.
+    let origin = locations.origin(span)?;
+    let place = |at: LineColumn| {
+        let (line, column) = origin.place(at.line, at.column);
+        LineColumn { line, column }
+    };
+    let start = place(span.start());
     let lines = source.lines().count().max(1);
     if start.line == 0 || start.line > lines {
         return None;
     }
-    Some((start, Some(span.end())))
+    Some((start, Some(place(span.end()))))
 }
 
 /// Just after the last character of the last non-blank line.
@@ -146,10 +165,12 @@ mod tests {
     use super::*;
 
     fn rendered(source: &str) -> String {
-        match mechgen::compile_str(source) {
-            Ok(_) => panic!("expected errors"),
-            Err(errors) => render("scene.mech", source, &errors),
-        }
+        let read = mechgen::source::read(source, &mechgen::limits::Limits::default());
+        let errors = match read.spec {
+            Ok(spec) => mechgen::compile_spec(&spec).err().expect("errors"),
+            Err(error) => error.into(),
+        };
+        render("scene.mech", source, &read.locations, &errors)
     }
 
     #[test]

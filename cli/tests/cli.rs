@@ -258,6 +258,83 @@ mechanism Broken {
     let _ = std::fs::remove_file(&path);
 }
 
+/// A scene of `markers` marker statements (about 40 bytes each) after a four-line pendulum.
+fn many_markers(markers: usize, last: &str) -> String {
+    let mut source = "mechanism Many {\n    ground frame at (0, 0, 0);\n    \
+                      body arm near (1, 0, 0);\n    joint pivot: revolute(frame, arm);\n    \
+                      driver spin: angle(arm) = t;\n"
+        .to_owned();
+    for k in 0..markers {
+        source.push_str(&format!("    marker m{k}: arm @ ({k}, 0); // no. {k}\n"));
+    }
+    source + last + "}\n"
+}
+
+#[test]
+fn large_scenes_are_refused_before_they_are_read_and_errors_placed_in_any_chunk() {
+    // 5,000 markers, about 200 kB: read in several chunks.
+    let path = scratch("many.mech");
+    let source = many_markers(5000, "    marker late: arm @ (1, q);\n");
+    std::fs::write(&path, &source).expect("scene written");
+    let name = path.to_str().expect("UTF-8 path");
+
+    let out = mechgen(&["check", name, "--max-file-size", "1000"]);
+    assert_eq!(out.status.code(), Some(1));
+    let message = text(&out.stderr);
+    let size = format!(
+        "`{name}` is {} bytes, more than the 1000 bytes",
+        source.len()
+    );
+    assert!(message.contains(&size), "{message}");
+    assert!(
+        message.contains("hint: pass `--max-file-size BYTES`"),
+        "{message}"
+    );
+
+    // Statement 101 is the 97th marker, on line 102 (the header line, four statements, then
+    // one marker a line).
+    let out = mechgen(&["check", name, "--max-statements", "100"]);
+    assert_eq!(out.status.code(), Some(1));
+    let message = text(&out.stderr);
+    let many = format!("{name}:102:5: error: the scene has 5005 statements, more than the 100");
+    assert!(message.contains(&many), "{message}");
+
+    // Within the limits, an error in the last chunk is placed on its line and column.
+    let out = mechgen(&["check", name]);
+    assert_eq!(out.status.code(), Some(1));
+    let message = text(&out.stderr);
+    let late = format!("{name}:5006:28: error: unknown name `q`");
+    assert!(message.contains(&late), "{message}");
+    assert!(
+        message.contains(
+            "5006 |     marker late: arm @ (1, q);\n     |                            ^\n"
+        ),
+        "{message}"
+    );
+
+    // Standard input is cut off at the limit.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_mechgen"))
+        .args(["check", "-", "--max-file-size", "1000"])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("mechgen runs");
+    if let Some(mut stdin) = child.stdin.take() {
+        use std::io::Write as _;
+        // The reader may stop early: a broken pipe is expected.
+        let _ = stdin.write_all(source.as_bytes());
+    }
+    let out = child.wait_with_output().expect("mechgen ends");
+    assert_eq!(out.status.code(), Some(1));
+    let message = text(&out.stderr);
+    assert!(
+        message.contains("`<stdin>` is more than 1000 bytes"),
+        "{message}"
+    );
+    let _ = std::fs::remove_file(&path);
+}
+
 #[test]
 fn unreadable_files_say_so() {
     let out = mechgen(&["check", "no/such/scene.mech"]);

@@ -32,6 +32,7 @@ pub mod model;
 pub mod parse;
 pub mod reactions;
 pub mod resolution;
+pub mod source;
 pub mod spec;
 pub mod spline;
 pub mod stats;
@@ -75,6 +76,15 @@ pub fn compile(tokens: TokenStream) -> Result<Scene, Errors> {
 pub fn compile_str(source: &str) -> Result<Scene, Errors> {
     let spec = parse::parse_str(source)?;
     scene(&spec)
+}
+
+/// Checks and differentiates a parsed spec (read from text with [`source::read`], whose
+/// locations place the errors' spans in the text).
+///
+/// # Errors
+/// Every semantic error found, each at its span.
+pub fn compile_spec(spec: &spec::Spec) -> Result<Scene, Errors> {
+    scene(spec)
 }
 
 fn scene(spec: &spec::Spec) -> Result<Scene, Errors> {
@@ -136,12 +146,15 @@ pub fn expand_or_errors(tokens: TokenStream) -> TokenStream {
 }
 
 /// Parses, checks and differentiates a `.mech` source for emission with `options` (the naive
-/// baseline compiles into an unsimplified arena).
+/// baseline compiles into an unsimplified arena). The text is read without the size and count
+/// limits (nesting and statement length still apply): this is the path for scenes a program
+/// writes, such as `builder`'s.
 ///
 /// # Errors
 /// As [`compile_str`].
 pub fn compile_str_with(source: &str, options: &emit::CodegenOptions) -> Result<Scene, Errors> {
-    let spec = parse::parse_str(source)?;
+    // Text a program wrote (`builder`, a build script): size and count are the caller's call.
+    let spec = source::read(source, &limits::Limits::UNBOUNDED_SIZE).spec?;
     let arena = if options.naive {
         expr::Arena::unsimplified()
     } else {

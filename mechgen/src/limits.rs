@@ -1,7 +1,9 @@
-//! Size limits on the input tokens, checked before parsing: the parser, the checker and
+//! Size limits on the input, checked before parsing: the parser, the checker and
 //! differentiation recurse once per nesting level and per operator of a chain, so without them a
 //! pathological scene (thousands of nested brackets, a million-term sum) would overflow the stack
-//! and abort rustc or the CLI instead of getting an error message.
+//! and abort rustc or the CLI instead of getting an error message; and a file's size and
+//! statement count bound the time and memory a scene costs before anything is lexed (the text
+//! path, `source`, applies every limit while scanning characters, before it makes tokens).
 
 use proc_macro2::{Span, TokenStream, TokenTree};
 
@@ -10,6 +12,43 @@ pub const MAX_DEPTH: usize = 64;
 /// Most tokens accepted in one `;`-terminated statement (brackets included); a long driver
 /// expression has a few hundred.
 pub const MAX_STATEMENT_TOKENS: usize = 10_000;
+
+/// Largest `.mech` text read by default: 8 MiB, about 100 000 statements of typical length
+/// (a 1000-stage scissor lift written out by `builder` is under 1 MiB).
+pub const MAX_SOURCE_BYTES: usize = 8 << 20;
+/// Most statements read by default; `mechgen check` takes about 2 s and 70 MB on 100 000
+/// markers.
+pub const MAX_STATEMENTS: usize = 100_000;
+
+/// The limits a scene's text is read within. Nesting depth and statement length protect the
+/// stack and are fixed ([`MAX_DEPTH`], [`MAX_STATEMENT_TOKENS`]); size and count only bound the
+/// cost, so a caller that means to read a larger scene can raise them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limits {
+    /// Largest text, in bytes.
+    pub bytes: usize,
+    /// Most statements in the mechanism's body.
+    pub statements: usize,
+}
+
+impl Default for Limits {
+    /// [`MAX_SOURCE_BYTES`] and [`MAX_STATEMENTS`].
+    fn default() -> Self {
+        Limits {
+            bytes: MAX_SOURCE_BYTES,
+            statements: MAX_STATEMENTS,
+        }
+    }
+}
+
+impl Limits {
+    /// No limit on size or count (the depth and statement-length limits still apply): for
+    /// text a program wrote, such as `builder`'s.
+    pub const UNBOUNDED_SIZE: Limits = Limits {
+        bytes: usize::MAX,
+        statements: usize::MAX,
+    };
+}
 
 /// Checks `tokens` against [`MAX_DEPTH`] and [`MAX_STATEMENT_TOKENS`].
 ///

@@ -48,29 +48,35 @@ pub fn parse_tokens(tokens: TokenStream) -> syn::Result<Spec> {
     syn::parse2(tokens)
 }
 
-/// Parses a `mechanism` declaration from source text (a `.mech` file).
+/// Parses a `mechanism` declaration from source text (a `.mech` file) within the default
+/// [`Limits`](crate::limits::Limits), statement by statement (`source`).
+///
+/// The spans count lines and columns from the start of the chunk they were lexed in: place
+/// them in the text with [`crate::source::read`]'s locations.
 ///
 /// # Errors
-/// The first lexical or syntax error, with its position in the text.
+/// The first limit exceeded, bracket problem, lexical or syntax error, at its position.
 pub fn parse_str(source: &str) -> syn::Result<Spec> {
-    let tokens: TokenStream = syn::parse_str(source)?;
-    parse_tokens(tokens)
+    crate::source::read(source, &crate::limits::Limits::default()).spec
 }
 
-impl Parse for Spec {
-    fn parse(input: ParseStream) -> syn::Result<Self> {
-        let docs = doc_attributes(input)?;
-        let vis: Visibility = input.parse()?;
-        input.parse::<kw::mechanism>().map_err(|e| {
-            syn::Error::new(
-                e.span(),
-                "expected `mechanism Name { … }` (optionally preceded by doc comments and `pub`)",
-            )
-        })?;
-        let name: Ident = input.parse()?;
-        let content;
-        braced!(content in input);
-        let mut spec = Spec {
+/// `/// docs pub mechanism Name`: everything before the body.
+pub(crate) fn header(input: ParseStream) -> syn::Result<(Vec<Attribute>, Visibility, Ident)> {
+    let docs = doc_attributes(input)?;
+    let vis: Visibility = input.parse()?;
+    input.parse::<kw::mechanism>().map_err(|e| {
+        syn::Error::new(
+            e.span(),
+            "expected `mechanism Name { … }` (optionally preceded by doc comments and `pub`)",
+        )
+    })?;
+    Ok((docs, vis, input.parse()?))
+}
+
+impl Spec {
+    /// A spec with its header and no statements yet.
+    pub(crate) fn new(docs: Vec<Attribute>, vis: Visibility, name: Ident) -> Self {
+        Spec {
             docs,
             vis,
             name,
@@ -83,7 +89,16 @@ impl Parse for Spec {
             loads: Vec::new(),
             markers: Vec::new(),
             outputs: None,
-        };
+        }
+    }
+}
+
+impl Parse for Spec {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let (docs, vis, name) = header(input)?;
+        let content;
+        braced!(content in input);
+        let mut spec = Spec::new(docs, vis, name);
         while !content.is_empty() {
             statement(&content, &mut spec)?;
         }
@@ -108,7 +123,8 @@ fn doc_attributes(input: ParseStream) -> syn::Result<Vec<Attribute>> {
     Ok(attrs)
 }
 
-fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> {
+/// One `;`-terminated statement of the body, added to `spec`.
+pub(crate) fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> {
     let docs = doc_attributes(input)?;
     let look = input.lookahead1();
     if look.peek(kw::param) {
