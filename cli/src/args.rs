@@ -91,8 +91,9 @@ struct SolveFlags {
     /// The scene (a .mech file, or `-` for standard input)
     #[arg(value_name = "FILE")]
     file: PathBuf,
-    /// End time of equally spaced samples (seconds)
-    #[arg(long, value_name = "T", allow_negative_numbers = true, value_parser = finite,
+    /// End time of equally spaced samples (seconds; a number or a constant expression such as
+    /// `2*pi/10`)
+    #[arg(long, value_name = "T", allow_hyphen_values = true, value_parser = time_value,
           requires = "steps")]
     t_end: Option<f64>,
     /// Number of equal steps, at least 1 (N + 1 rows are written)
@@ -100,17 +101,18 @@ struct SolveFlags {
           requires = "t_end")]
     steps: Option<u32>,
     /// Start time of equally spaced samples, where the mechanism is assembled
-    #[arg(long, value_name = "T0", allow_negative_numbers = true, value_parser = finite,
+    #[arg(long, value_name = "T0", allow_hyphen_values = true, value_parser = time_value,
           default_value_t = 0.0, requires = "t_end")]
     t0: f64,
-    /// Solve at exactly these times (comma-separated, strictly increasing)
-    #[arg(long, value_name = "T1,T2,…", value_delimiter = ',', allow_hyphen_values = true,
-          value_parser = finite)]
-    at: Vec<f64>,
+    /// Solve at exactly these times (comma-separated, strictly increasing; each a number or a
+    /// constant expression)
+    #[arg(long, value_name = "T1,T2,…", allow_hyphen_values = true)]
+    at: Vec<String>,
     /// Solve at the times listed in FILE, one a line
     #[arg(long, value_name = "FILE")]
     times: Option<PathBuf>,
-    /// Override a parameter's default (repeatable; `mechgen check FILE` lists them)
+    /// Override a parameter's default (repeatable; `mechgen check FILE` lists them; the value
+    /// a number or a constant expression such as `30deg`)
     #[arg(long = "set", value_name = "NAME=VALUE", value_parser = set_value)]
     sets: Vec<(String, f64)>,
     /// Write the results to OUT instead of standard output (`-`: standard output)
@@ -167,7 +169,7 @@ pub enum CheckFormat {
     /// The readable report
     #[default]
     Text,
-    /// The same facts as one JSON object (see `inspect::Summary`)
+    /// The same facts as one JSON object (fields listed in the README's command-line section)
     Json,
 }
 
@@ -273,11 +275,13 @@ fn solve_args(flags: SolveFlags, limits: Limits) -> Result<SolveArgs, clap::Erro
         (Some(t_end), Some(steps), _) => {
             if t_end == flags.t0 {
                 return Err(invalid(format!(
-                    "`--t-end` ({t_end}) equals the start time ({}): give an end time that \
+                    "`--t-end` ({}) equals the start time ({}): give an end time that \
                      differs from `--t0` (which defaults to 0)",
-                    flags.t0
+                    time(t_end),
+                    time(flags.t0)
                 )));
             }
+            resolved_steps(flags.t0, t_end, steps).map_err(invalid)?;
             Times::Equal {
                 t0: flags.t0,
                 t_end,
@@ -285,7 +289,17 @@ fn solve_args(flags: SolveFlags, limits: Limits) -> Result<SolveArgs, clap::Erro
             }
         }
         (_, _, Some(file)) => Times::File(file),
-        _ => Times::Listed(increasing(flags.at, "`--at`").map_err(invalid)?),
+        _ => {
+            let mut times = Vec::new();
+            for list in &flags.at {
+                for item in split_top_level(list) {
+                    let t = time_value(item)
+                        .map_err(|e| invalid(format!("`--at` item `{}`: {e}", item.trim())))?;
+                    times.push(t);
+                }
+            }
+            Times::Listed(increasing(times, "`--at`").map_err(invalid)?)
+        }
     };
     for (k, (name, _)) in flags.sets.iter().enumerate() {
         if flags.sets[..k].iter().any(|(n, _)| n == name) {
@@ -315,12 +329,71 @@ fn solve_args(flags: SolveFlags, limits: Limits) -> Result<SolveArgs, clap::Erro
     })
 }
 
-/// A usage error with clap's formatting (and exit status 2).
-fn invalid(message: String) -> clap::Error {
-    Cli::command()
-        .find_subcommand_mut("solve")
-        .map_or_else(Cli::command, |c| c.clone())
+/// A usage error of `mechgen solve` with clap's formatting (`Usage: mechgen solve …`, exit
+/// status 2).
+pub(crate) fn invalid(message: String) -> clap::Error {
+    let mut command = Cli::command();
+    // Building gives the subcommand its full name (`mechgen solve`) for the usage line.
+    command.build();
+    command
+        .find_subcommand("solve")
+        .cloned()
+        .unwrap_or(command)
         .error(clap::error::ErrorKind::ValueValidation, message)
+}
+
+/// Largest time magnitude accepted, in seconds: beyond it doubles are more than 0.1 s apart
+/// (at 1e15 s, 0.125 s), so times cannot be resolved, and any motion driven by `t` would be
+/// far beyond what the solver resolves anyway (`Unresolved`).
+pub const MAX_TIME: f64 = 1e15;
+
+/// A time written in shortest round-trip form, with an exponent for huge and tiny ones.
+pub fn time(t: f64) -> String {
+    if t != 0.0 && !(1e-4..1e6).contains(&t.abs()) {
+        format!("{t:e}")
+    } else {
+        format!("{t}")
+    }
+}
+
+/// Equal steps from `t0` to `t_end` that double precision resolves: the span is finite and
+/// each step covers several doubles, so the sample times increase strictly.
+fn resolved_steps(t0: f64, t_end: f64, steps: u32) -> Result<(), String> {
+    let h = (t_end - t0) / f64::from(steps);
+    let largest = t0.abs().max(t_end.abs());
+    // The distance from `largest` to the next double.
+    let spacing = f64::from_bits(largest.to_bits() + 1) - largest;
+    if h.abs() > 4.0 * spacing {
+        return Ok(());
+    }
+    Err(format!(
+        "{steps} equal steps from t = {} to {} are {} s each, which double precision cannot \
+         resolve at t = {} (doubles there are {} s apart): give fewer `--steps` or a longer \
+         time span",
+        time(t0),
+        time(t_end),
+        time(h),
+        time(largest),
+        time(spacing)
+    ))
+}
+
+/// `text` split at the commas outside parentheses (`0, atan2(1, 2)` is two items).
+fn split_top_level(text: &str) -> Vec<&str> {
+    let (mut items, mut depth, mut start) = (Vec::new(), 0i32, 0);
+    for (i, c) in text.char_indices() {
+        match c {
+            '(' => depth += 1,
+            ')' => depth -= 1,
+            ',' if depth == 0 => {
+                items.push(&text[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    items.push(&text[start..]);
+    items
 }
 
 /// `times` if non-empty and strictly increasing; otherwise what is wrong with them.
@@ -334,7 +407,8 @@ pub fn increasing(times: Vec<f64>, what: &str) -> Result<Vec<f64>, String> {
     if let Some(pair) = times.windows(2).find(|w| w[1] <= w[0]) {
         return Err(format!(
             "{what}: the times must be strictly increasing, but {} follows {}",
-            pair[1], pair[0]
+            time(pair[1]),
+            time(pair[0])
         ));
     }
     Ok(times)
@@ -351,24 +425,28 @@ pub fn parse_times(text: &str, name: &str) -> Result<Vec<f64>, String> {
         if line.is_empty() {
             continue;
         }
-        match line.parse::<f64>() {
-            Ok(t) if t.is_finite() => times.push(t),
-            _ => {
-                return Err(format!(
-                    "{name}:{}: `{line}` is not a finite time in seconds",
-                    number + 1
-                ));
-            }
+        match time_value(line) {
+            Ok(t) => times.push(t),
+            Err(e) => return Err(format!("{name}:{}: `{line}`: {e}", number + 1)),
         }
     }
     increasing(times, name)
 }
 
-fn finite(text: &str) -> Result<f64, String> {
-    match text.trim().parse::<f64>() {
-        Ok(t) if t.is_finite() => Ok(t),
-        _ => Err("expected a finite number of seconds, e.g. `0.02`".to_owned()),
+/// A time: a number or a constant expression (`2*pi/10`), within ±[`MAX_TIME`].
+fn time_value(text: &str) -> Result<f64, String> {
+    let t = mechgen::check::constant_value(text)
+        .map_err(|e| format!("expected a finite time in seconds, e.g. `0.02` or `2*pi/10`: {e}"))?;
+    if t.abs() > MAX_TIME {
+        return Err(format!(
+            "{} s cannot be resolved: times beyond ±{} s are more than 0.1 s apart in double \
+             precision; give a smaller time (shift the time origin with `--t0` and the \
+             drivers' phase)",
+            time(t),
+            time(MAX_TIME)
+        ));
     }
+    Ok(t)
 }
 
 /// `NAME=VALUE`; the value only has to be a finite number here (the name is checked against
@@ -381,10 +459,11 @@ fn set_value(set: &str) -> Result<(String, f64), String> {
     if name.is_empty() {
         return Err("no parameter name before `=`: e.g. `--set omega=100`".to_owned());
     }
-    match value.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok((name.to_owned(), v)),
-        _ => Err(format!(
-            "`{value}` is not a finite number; e.g. `--set {name}=100`"
+    match mechgen::check::constant_value(value) {
+        Ok(v) => Ok((name.to_owned(), v)),
+        Err(e) => Err(format!(
+            "`{value}` is not a finite number ({e}); e.g. `--set {name}=100` or \
+             `--set {name}=30deg`"
         )),
     }
 }
@@ -499,9 +578,76 @@ mod tests {
     }
 
     #[test]
+    fn times_and_values_are_constant_expressions() {
+        let pi = core::f64::consts::PI;
+        let Ok(Command::Solve(args)) = parse_strs(&[
+            "solve",
+            "s",
+            "--t-end",
+            "2*pi/10",
+            "--steps",
+            "4",
+            "--t0",
+            "-pi/10",
+            "--set",
+            "gamma=30deg",
+        ]) else {
+            panic!("parses");
+        };
+        let expected = Times::Equal {
+            t0: -pi / 10.0,
+            t_end: 2.0 * pi / 10.0,
+            steps: 4,
+        };
+        assert_eq!(args.times, expected);
+        assert_eq!(args.sets, [("gamma".to_owned(), pi / 6.0)]);
+        let Ok(Command::Solve(args)) =
+            parse_strs(&["solve", "s", "--at", "0, atan2(1, 1),pi/2", "--at", "2"])
+        else {
+            panic!("parses");
+        };
+        assert_eq!(
+            args.times,
+            Times::Listed(vec![0.0, pi / 4.0, pi / 2.0, 2.0])
+        );
+        assert!(error(&["solve", "a", "--at", "0,t"]).contains("`t` is not a number"));
+    }
+
+    #[test]
+    fn unresolvable_times_are_refused_in_short_form() {
+        let huge = error(&["solve", "a", "--t-end", "1e308", "--steps", "2"]);
+        assert!(huge.contains("1e308 s cannot be resolved"), "{huge}");
+        assert!(!huge.contains("000000000000"), "{huge}");
+        let fine = error(&[
+            "solve",
+            "a",
+            "--t0",
+            "1e9",
+            "--t-end",
+            "1e9 + 1e-6",
+            "--steps",
+            "100",
+        ]);
+        assert!(fine.contains("double precision cannot resolve"), "{fine}");
+        assert!(fine.contains("t = 1e9"), "{fine}");
+        assert_eq!(time(1e308), "1e308");
+        assert_eq!(time(0.02), "0.02");
+        assert_eq!(time(-1.5e-7), "-1.5e-7");
+    }
+
+    #[test]
+    fn usage_errors_name_the_program() {
+        let order = error(&["solve", "a", "--at", "0.2,0.1"]);
+        assert!(order.contains("Usage: mechgen solve"), "{order}");
+    }
+
+    #[test]
     fn times_files() {
-        let times = parse_times("# t\n0\n\n0.1 # first\n  0.30000000000000004\n", "f").unwrap();
-        assert_eq!(times, [0.0, 0.1, 0.30000000000000004]);
+        let times = parse_times("# t\n0\n\n0.1 # first\n  0.30000000000000004\npi\n", "f").unwrap();
+        assert_eq!(
+            times,
+            [0.0, 0.1, 0.30000000000000004, core::f64::consts::PI]
+        );
         assert!(parse_times("0\nx\n", "f").unwrap_err().contains("f:2"));
         assert!(
             parse_times("0.2\n0.1\n", "f")

@@ -208,7 +208,12 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     let scene = compile(&source, &args.limits)?;
     let schedule = Schedule::resolve(&args.times)?;
     let mut mechanism = Interpreted::new(&scene);
-    solve::apply_sets(&mut mechanism, &args.sets).map_err(failed)?;
+    solve::apply_sets(&mut mechanism, &args.sets).map_err(|error| match error {
+        solve::SetError::Unknown(message) => {
+            Failure::Usage(args::invalid(message).render().to_string())
+        }
+        solve::SetError::Invalid(message) => failed(message),
+    })?;
     // Assemble before touching the output, so that a scene that cannot move leaves an existing
     // CSV file as it was.
     let mut simulation = solve::assemble(mechanism, schedule.start()).map_err(failed)?;
@@ -296,14 +301,17 @@ impl Schedule {
     /// For the summary line: `t = 0 to 0.02 in 360 equal steps`.
     fn describe(&self) -> String {
         match self {
-            Schedule::Equal { t0, t_end, steps } => {
-                format!("t = {t0} to {t_end} in {}", count(*steps, "equal step"))
-            }
+            Schedule::Equal { t0, t_end, steps } => format!(
+                "t = {} to {} in {}",
+                args::time(*t0),
+                args::time(*t_end),
+                count(*steps, "equal step")
+            ),
             Schedule::Listed(times) => format!(
                 "{} from t = {} to {}",
                 count(times.len(), "listed time"),
-                self.start(),
-                times.last().copied().unwrap_or(0.0)
+                args::time(self.start()),
+                args::time(times.last().copied().unwrap_or(0.0))
             ),
         }
     }

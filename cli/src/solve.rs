@@ -33,31 +33,54 @@ pub enum RunError {
     },
 }
 
+/// Why `--set` overrides were refused.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum SetError {
+    /// A name the scene does not declare: a bad command line (exit status 2).
+    Unknown(String),
+    /// A value the scene refuses.
+    Invalid(String),
+}
+
+impl core::fmt::Display for SetError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            SetError::Unknown(message) | SetError::Invalid(message) => f.write_str(message),
+        }
+    }
+}
+
 /// Sets the `--set` overrides on `mechanism`, all or none.
 ///
 /// # Errors
-/// A message naming the bad override and listing the parameters the scene declares.
-pub fn apply_sets(mechanism: &mut Interpreted, sets: &[(String, f64)]) -> Result<(), String> {
+/// A message naming the bad override, suggesting the declared name closest to a misspelt one
+/// and listing the parameters the scene declares.
+pub fn apply_sets(mechanism: &mut Interpreted, sets: &[(String, f64)]) -> Result<(), SetError> {
     // Checked before any is set, so that the list in the message shows the scene's defaults.
     for (name, value) in sets {
-        let declared = (0..mechanism.parameter_count())
-            .any(|i| mechanism.parameter_name(i) == Some(name.as_str()));
-        let problem = if !declared {
-            format!("the scene declares no parameter `{name}`")
-        } else if !value.is_finite() {
-            "parameter values must be finite numbers".to_owned()
-        } else {
-            continue;
-        };
-        return Err(format!(
-            "`--set {name}={value}`: {problem}; {}",
-            declared_parameters(mechanism)
-        ));
+        let names: Vec<&str> = (0..mechanism.parameter_count())
+            .filter_map(|i| mechanism.parameter_name(i))
+            .collect();
+        if !names.contains(&name.as_str()) {
+            let hint = mechgen::check::did_you_mean(name, names.iter().copied())
+                .map(|close| format!("did you mean `{close}`? "))
+                .unwrap_or_default();
+            return Err(SetError::Unknown(format!(
+                "`--set {name}={value}`: the scene declares no parameter `{name}`; {hint}{}",
+                declared_parameters(mechanism)
+            )));
+        }
+        if !value.is_finite() {
+            return Err(SetError::Invalid(format!(
+                "`--set {name}={value}`: parameter values must be finite numbers; {}",
+                declared_parameters(mechanism)
+            )));
+        }
     }
     for (name, value) in sets {
         mechanism
             .set_parameter(name, *value)
-            .map_err(|error| format!("`--set {name}={value}`: {error}"))?;
+            .map_err(|error| SetError::Invalid(format!("`--set {name}={value}`: {error}")))?;
     }
     Ok(())
 }
@@ -341,11 +364,13 @@ mod tests {
         assert_eq!(mechanism.parameter(0), Some(5.0));
         let mut fresh = Interpreted::new(&scene);
         let sets = [("w".into(), 7.0), ("v".into(), 1.0)];
-        let unknown = apply_sets(&mut fresh, &sets).unwrap_err();
+        let unknown = apply_sets(&mut fresh, &sets).unwrap_err().to_string();
         assert!(unknown.contains("no parameter `v`"), "{unknown}");
         assert!(unknown.contains("`w` (default 3)"), "{unknown}");
         assert_eq!(fresh.parameter(0), Some(3.0), "all or none");
-        let infinite = apply_sets(&mut mechanism, &[("w".into(), f64::INFINITY)]).unwrap_err();
+        let infinite = apply_sets(&mut mechanism, &[("w".into(), f64::INFINITY)])
+            .unwrap_err()
+            .to_string();
         assert!(infinite.contains("finite"), "{infinite}");
     }
 }

@@ -211,11 +211,24 @@ fn unknown_parameters_list_the_declared_ones() {
         "--set",
         "speed=3",
     ]);
-    assert_eq!(out.status.code(), Some(1));
+    // A name the scene does not declare is a bad command line.
+    assert_eq!(out.status.code(), Some(2));
     let message = text(&out.stderr);
     assert!(message.contains("no parameter `speed`"), "{message}");
     assert!(message.contains("`omega` (default 314)"), "{message}");
+    assert!(message.contains("Usage: mechgen solve"), "{message}");
     assert!(out.stdout.is_empty());
+    let out = mechgen(&[
+        "solve",
+        &scene("piston_crank.mech"),
+        "--at",
+        "0",
+        "--set",
+        "omgea=2*pi",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let message = text(&out.stderr);
+    assert!(message.contains("did you mean `omega`?"), "{message}");
 }
 
 #[test]

@@ -5,9 +5,12 @@
 //! scene sees everything at once rather than one error per build. The dynamics part of a spec
 //! (mass properties, gravity, loads) is checked in `check/dynamics.rs`.
 
+mod constant;
 mod dynamics;
 mod functions;
 mod library;
+
+pub use constant::constant_value;
 
 use std::collections::HashMap;
 
@@ -912,8 +915,8 @@ fn plural(n: i64) -> &'static str {
 }
 
 /// The candidate closest to a misspelt `name`, if it is plausibly a typo (edit distance ≤ 2 and
-/// less than half the name).
-fn did_you_mean<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+/// less than half the name). Public for the command line's suggestions.
+pub fn did_you_mean<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<&'a str> {
     candidates
         .map(|c| (edit_distance(name, c), c))
         .filter(|&(d, _)| d <= 2 && 2 * d < name.chars().count().max(2))
