@@ -73,9 +73,16 @@ enum Sub {
         format: CheckFormat,
     },
     /// Solve positions, velocities and accelerations (and the forces, for a scene with masses or
-    /// loads) over time with the interpreter and the runtime solver, and write them as CSV
-    /// (columns t, then q, q_dot, q_ddot of every coordinate, then each equation's reaction) or
+    /// loads) over time with the interpreter and the runtime solver, and write them as CSV or
     /// JSON
+    ///
+    /// CSV columns, in order: `t`; every coordinate (`piston.x`, …), then the same names with
+    /// `_dot` and `_ddot` when the scene computes them; every marker's values (`tip.x`, `tip.y`,
+    /// `tip.x_dot`, …, `gap.angle`, …); for a scene with forces, one reaction per equation in
+    /// the order `mechgen check` numbers the equations (`crank_pin.fx`, `crank_pin.fy`, …,
+    /// `slide.normal`, `slide.torque`, `crank_angle.effort`); with `--diagnostics`, the
+    /// per-step columns. JSON lists the same names under `coordinates`, `markers` and
+    /// `reactions`, then the states.
     #[command(after_help = format!("{TIMES_HELP}\n\n{EXIT_STATUS}"))]
     Solve(SolveFlags),
     /// Print a completion script for a shell (e.g. `mechgen completions bash > mechgen.bash`)

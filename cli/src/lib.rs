@@ -215,8 +215,13 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         solve::SetError::Invalid(message) => failed(message),
     })?;
     // Assemble before touching the output, so that a scene that cannot move leaves an existing
-    // CSV file as it was.
-    let mut simulation = solve::assemble(mechanism, schedule.start()).map_err(failed)?;
+    // CSV file as it was (a JSON document still records the failure).
+    let assembled = solve::assemble(mechanism, schedule.start());
+    if let Err(failure) = &assembled
+        && args.format == solve::Format::Csv
+    {
+        return Err(failed(&failure.message));
+    }
 
     let mut file;
     let (out, destination): (&mut dyn Write, String) = match &args.out {
@@ -234,6 +239,15 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         }
     };
 
+    let mut simulation = match assembled {
+        Ok(simulation) => simulation,
+        Err(failure) => {
+            solve::write_unassembled(&failure, args.format, out)
+                .and_then(|()| out.flush())
+                .map_err(|e| write_failure(&e, &destination))?;
+            return Err(failed(&failure.message));
+        }
+    };
     let outcome = solve::run(
         &mut simulation,
         schedule.after_start(),

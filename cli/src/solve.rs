@@ -100,18 +100,61 @@ fn declared_parameters(mechanism: &Interpreted) -> String {
     }
 }
 
+/// A scene that could not be assembled: what to tell the user, and what a JSON document
+/// records of it.
+pub struct Unassembled {
+    /// The solver's error, described with the scene's names and a hint.
+    pub message: String,
+    /// The solver's error.
+    pub error: SolveError,
+    /// The scene, for the document's header.
+    pub mechanism: Interpreted,
+}
+
 /// Assembles `mechanism` at `t0`.
 ///
 /// # Errors
 /// The solver's error, described with the scene's names and a hint.
-pub fn assemble(mechanism: Interpreted, t0: f64) -> Result<Simulation<Interpreted>, String> {
+pub fn assemble(
+    mechanism: Interpreted,
+    t0: f64,
+) -> Result<Simulation<Interpreted>, Box<Unassembled>> {
     Simulation::new(Solver::new(mechanism), t0).map_err(|failure| {
-        format!(
+        let message = format!(
             "cannot assemble `{}`: {failure}\n  hint: {}",
             failure.solver.mechanism().name(),
             assembly_hint(&failure.error)
-        )
+        );
+        Box::new(Unassembled {
+            message,
+            error: failure.error,
+            mechanism: failure.solver.into_mechanism(),
+        })
     })
+}
+
+/// Writes the JSON document of a run that could not assemble: the header, no states, and the
+/// error at step 0 (CSV has nothing to write).
+///
+/// # Errors
+/// Whatever `out` returns.
+pub fn write_unassembled(
+    failure: &Unassembled,
+    format: Format,
+    out: &mut dyn Write,
+) -> std::io::Result<()> {
+    if format != Format::Json {
+        return Ok(());
+    }
+    let mut rows = Rows {
+        format,
+        diagnostics: false,
+        out,
+        line: String::new(),
+        rows: 0,
+    };
+    rows.start(&failure.mechanism)?;
+    rows.finish(Some((0, &failure.error, &failure.message)))
 }
 
 const GEOMETRY_HINT: &str = "change the named parameter with `--set NAME=VALUE` (its default is in the scene; \
@@ -175,13 +218,13 @@ fn step_hint(error: &SolveError) -> &'static str {
 pub const DIAGNOSTIC_COLUMNS: &str = "iterations,substeps,evaluations,fallbacks,condition,det_sign";
 
 /// How `solve` writes its results. CSV: a header line, then one line per time (`t`, q, q_dot,
-/// q_ddot, the reactions of a scene with forces, and with `--diagnostics` the
-/// [`DIAGNOSTIC_COLUMNS`]). JSON: one document, `{"mechanism", "coordinates", "outputs",
-/// ["reactions",] "states": [State…], "error"}`, each state as the runtime serialises it (`t`,
-/// `q`, `q_dot`, `q_ddot`, `reactions`, `iterations`, `evaluations`, `substeps`, `condition`,
-/// `fallbacks`, `det_sign`), and `error` `null` or
-/// `{"step", "message", "kind"}`; written as the run goes, so a failed run still leaves a
-/// complete document. (The variants' docs are the CLI's help.)
+/// q_ddot, the marker values, the reactions of a scene with forces, and with `--diagnostics`
+/// the [`DIAGNOSTIC_COLUMNS`]). JSON: one document, `{"mechanism", "coordinates", "outputs",
+/// ["markers",] ["reactions",] "states": [State…], "error"}`, each state as the runtime
+/// serialises it (`t`, `q`, `q_dot`, `q_ddot`, `markers`, `reactions`, `iterations`,
+/// `evaluations`, `substeps`, `condition`, `fallbacks`, `det_sign`), and `error` `null` or
+/// `{"step", "message", "kind"}` (step 0: the assembly); written as the run goes, so a failed
+/// run still leaves a complete document. (The variants' docs are the CLI's help.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Format {
     /// A header line, then one line per time
@@ -227,6 +270,10 @@ impl Rows<'_> {
                 if !reactions.is_empty() {
                     head["reactions"] = serde_json::json!(reactions);
                 }
+                let markers: Vec<&str> = (0..).map_while(|i| m.marker_name(i)).collect();
+                if !markers.is_empty() {
+                    head["markers"] = serde_json::json!(markers);
+                }
                 let head = head.to_string();
                 // `{…}` without its closing brace, then the states array.
                 self.line.push_str(&head[..head.len() - 1]);
@@ -251,8 +298,9 @@ impl Rows<'_> {
                     self.line.push_str(",\n");
                 }
                 // A state is numbers and arrays of numbers: it always serialises.
-                self.line
-                    .push_str(&serde_json::to_string(state).unwrap_or_default());
+                let mut value = serde_json::to_value(state).unwrap_or_default();
+                positive_zeros(&mut value);
+                self.line.push_str(&value.to_string());
             }
         }
         self.rows += 1;
@@ -331,6 +379,19 @@ pub fn run(
     }
     rows.finish(None).map_err(RunError::Write)?;
     Ok(summary)
+}
+
+/// Replaces every −0.0 in `value` by 0.0 (a velocity of −0 reads as a sign where there is
+/// none; CSV rows do the same).
+fn positive_zeros(value: &mut serde_json::Value) {
+    match value {
+        serde_json::Value::Number(n) if n.as_f64() == Some(0.0) && n.is_f64() => {
+            *value = serde_json::json!(0.0);
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(positive_zeros),
+        serde_json::Value::Object(fields) => fields.values_mut().for_each(positive_zeros),
+        _ => {}
+    }
 }
 
 /// `,iterations,substeps,evaluations,fallbacks,condition,det_sign` of a state, and the newline.

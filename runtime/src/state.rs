@@ -227,13 +227,15 @@ where
     /// `\n`, matching [`write_csv_header`].
     ///
     /// Numbers are the shortest strings that parse back to the same value, with an exponent
-    /// for tiny and huge magnitudes (`5.2e-30`). A NaN or infinity (which a successful solve
-    /// never produces) is written as `NaN`/`inf`/`-inf`, which float parsers accept.
+    /// for tiny and huge magnitudes (`5.2e-30`), and −0 written as `0.0` (a sign where there is
+    /// none only confuses a reader). A NaN or infinity (which a successful solve never
+    /// produces) is written as `NaN`/`inf`/`-inf`, which float parsers accept.
     ///
     /// # Errors
     /// Whatever `out` returns.
     pub fn write_csv_row<W: Write>(&self, out: &mut W) -> fmt::Result {
-        write!(out, "{:?}", self.t)?;
+        // `x + 0.0` is `x`, except that −0 becomes +0.
+        write!(out, "{:?}", self.t + 0.0)?;
         let groups = column_groups(self.outputs);
         let kinematics = [&self.q, &self.velocities, &self.accelerations];
         let forces = (groups > kinematics.len()).then_some(self.reactions.as_slice());
@@ -245,7 +247,7 @@ where
             .chain(forces);
         for column in columns {
             for value in column {
-                write!(out, ",{value:?}")?;
+                write!(out, ",{:?}", value + 0.0)?;
             }
         }
         out.write_char('\n')
