@@ -60,9 +60,6 @@ fn main() {
         }],
     }];
     let title = "Planetary gear set: a planet tooth over one carrier turn (a hypocycloid)";
-    if let Some(dir) = options.svg.parent() {
-        let _ = std::fs::create_dir_all(dir);
-    }
     match plot::write_svg(&options.svg, title, "x (mm)", &panels) {
         Ok(()) => println!("plot: {}", options.svg.display()),
         Err(e) => {

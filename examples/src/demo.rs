@@ -179,17 +179,12 @@ impl<M: Mechanism<Dim = Const<N>>, const N: usize> Revolution<M, N> {
         x_label: &str,
         panels: &[Panel<'_>],
     ) -> Result<(), String> {
-        let directory = options.svg.parent().filter(|d| !d.as_os_str().is_empty());
-        directory
-            .map_or(Ok(()), std::fs::create_dir_all)
-            .map_err(Box::<dyn Error>::from)
-            .and_then(|()| Ok(plot::write_svg(&options.svg, title, x_label, panels)?))
-            .map_err(|e| {
-                format!(
-                    "writing the plot {}: {e}\n  hint: give a writable path with `--svg PATH`",
-                    options.svg.display()
-                )
-            })?;
+        plot::write_svg(&options.svg, title, x_label, panels).map_err(|e| {
+            format!(
+                "writing the plot {}: {e}\n  hint: give a writable path with `--svg PATH`",
+                options.svg.display()
+            )
+        })?;
         println!("plot: {}", options.svg.display());
         if let Some(path) = &options.csv {
             self.write_csv(path)
@@ -277,13 +272,25 @@ mod tests {
             series: &series,
         }];
         let dir = std::env::temp_dir().join(format!("mechgen-demo-{}", std::process::id()));
-        let written = Options {
+        // A missing directory is named, not created.
+        let missing = Options {
             csv: None,
             svg: dir.join("new/plot.svg"),
         };
+        let error = run
+            .try_write_outputs(&missing, "t", "x", &panels)
+            .unwrap_err();
+        let named = format!("the directory `{}` does not exist", dir.display());
+        assert!(error.contains(&named), "{error}");
+        assert!(!dir.exists());
+        std::fs::create_dir_all(&dir).unwrap();
+        let written = Options {
+            csv: None,
+            svg: dir.join("plot.svg"),
+        };
         run.try_write_outputs(&written, "t", "x", &panels).unwrap();
         assert!(written.svg.exists());
-        // A path under a regular file: its directory cannot be created.
+        // A path under a regular file: it cannot be written.
         let blocked = Options {
             csv: None,
             svg: written.svg.join("plot.svg"),

@@ -39,6 +39,9 @@ pub struct Panel<'a> {
 pub enum PlotError {
     /// The plotting backend failed while drawing.
     Draw(String),
+    /// The directory the SVG file would go in does not exist (it is not created: a typo in a
+    /// path should not leave new directories behind).
+    MissingDirectory(std::path::PathBuf),
     /// Writing the SVG file failed.
     Io(std::io::Error),
 }
@@ -47,6 +50,12 @@ impl fmt::Display for PlotError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             PlotError::Draw(msg) => write!(f, "plot drawing failed: {msg}"),
+            PlotError::MissingDirectory(dir) => write!(
+                f,
+                "the directory `{}` does not exist: create it, or give a path in an existing \
+                 directory",
+                dir.display()
+            ),
             PlotError::Io(e) => write!(f, "writing plot failed: {e}"),
         }
     }
@@ -55,7 +64,7 @@ impl fmt::Display for PlotError {
 impl std::error::Error for PlotError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            PlotError::Draw(_) => None,
+            PlotError::Draw(_) | PlotError::MissingDirectory(_) => None,
             PlotError::Io(e) => Some(e),
         }
     }
@@ -114,15 +123,36 @@ pub fn figure_size(n_panels: usize) -> (u32, u32) {
 ///
 /// `title` goes on top, `x_label` (with units) under the bottom panel; all panels share the x range
 /// of all finite points.
+///
+/// # Errors
+/// [`PlotError::MissingDirectory`] naming the first directory of `path` that does not exist
+/// (none is created), a drawing or a write failure.
 pub fn write_svg(
     path: &Path,
     title: &str,
     x_label: &str,
     panels: &[Panel<'_>],
 ) -> Result<(), PlotError> {
+    if let Some(missing) = missing_directory(path) {
+        return Err(PlotError::MissingDirectory(missing));
+    }
     let svg = render_svg(title, x_label, panels)?;
     std::fs::write(path, svg)?;
     Ok(())
+}
+
+/// The outermost missing directory on the way to `path` (`out/plots` for `out/plots/a.svg`
+/// when `out` is missing), if any.
+fn missing_directory(path: &Path) -> Option<std::path::PathBuf> {
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty())?;
+    if parent.exists() {
+        return None;
+    }
+    let missing = parent
+        .ancestors()
+        .take_while(|a| !a.as_os_str().is_empty() && !a.exists())
+        .last()?;
+    Some(missing.to_path_buf())
 }
 
 /// Renders the panels as an SVG document and returns it as a string (see [`write_svg`]).
@@ -509,6 +539,19 @@ mod tests {
         write_svg(&path, "Empty", "x", &[]).expect("written");
         looks_like_svg(&std::fs::read_to_string(&path).expect("read back"));
         let _ = std::fs::remove_file(&path);
+    }
+
+    #[test]
+    fn missing_directories_are_named_not_created() {
+        let top = temp_path("missing").with_extension("");
+        let path = top.join("plots").join("a.svg");
+        let error = write_svg(&path, "T", "x", &[]).expect_err("no directory");
+        let message = error.to_string();
+        assert!(
+            message.contains(&format!("`{}` does not exist", top.display())),
+            "{message}"
+        );
+        assert!(!top.exists(), "nothing created");
     }
 
     #[test]
