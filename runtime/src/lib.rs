@@ -103,6 +103,7 @@ pub use workspace::{Buffers, Parts, Workspace};
 /// Re-exported so generated code and users name one crate.
 pub use nalgebra;
 
-/// Declares a mechanism and generates its kinematics; the grammar is documented in `mechgen::parse`.
+/// Declares a mechanism and generates its kinematics; the grammar follows (it is also on this
+/// crate's front page).
 #[cfg(feature = "macros")]
 pub use mechgen_macros::mechanism;
