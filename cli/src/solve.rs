@@ -298,9 +298,8 @@ impl Rows<'_> {
                     self.line.push_str(",\n");
                 }
                 // A state is numbers and arrays of numbers: it always serialises.
-                let mut value = serde_json::to_value(state).unwrap_or_default();
-                positive_zeros(&mut value);
-                self.line.push_str(&value.to_string());
+                let json = serde_json::to_string(state).unwrap_or_default();
+                self.line.push_str(&positive_zeros(&json));
             }
         }
         self.rows += 1;
@@ -381,17 +380,25 @@ pub fn run(
     Ok(summary)
 }
 
-/// Replaces every −0.0 in `value` by 0.0 (a velocity of −0 reads as a sign where there is
-/// none; CSV rows do the same).
-fn positive_zeros(value: &mut serde_json::Value) {
-    match value {
-        serde_json::Value::Number(n) if n.as_f64() == Some(0.0) && n.is_f64() => {
-            *value = serde_json::json!(0.0);
-        }
-        serde_json::Value::Array(items) => items.iter_mut().for_each(positive_zeros),
-        serde_json::Value::Object(fields) => fields.values_mut().for_each(positive_zeros),
-        _ => {}
+/// `json` with every number −0.0 written as 0.0 (a velocity of −0 reads as a sign where there
+/// is none; CSV rows do the same). serde_json writes −0 as `-0.0`, between delimiters.
+fn positive_zeros(json: &str) -> String {
+    let mut out = String::with_capacity(json.len());
+    let mut rest = json;
+    while let Some(at) = rest.find("-0.0") {
+        let before = rest[..at]
+            .chars()
+            .next_back()
+            .or_else(|| out.chars().next_back());
+        let after = rest[at + 4..].chars().next();
+        out.push_str(&rest[..at]);
+        let number =
+            matches!(before, Some('[' | ',' | ':')) && matches!(after, Some(',' | ']' | '}'));
+        out.push_str(if number { "0.0" } else { "-0.0" });
+        rest = &rest[at + 4..];
     }
+    out.push_str(rest);
+    out
 }
 
 /// `,iterations,substeps,evaluations,fallbacks,condition,det_sign` of a state, and the newline.
@@ -412,6 +419,14 @@ fn write_diagnostics(state: &State<Interpreted>, out: &mut String) -> core::fmt:
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn negative_zeros_become_zeros_only_as_whole_numbers() {
+        assert_eq!(
+            positive_zeros(r#"{"q":[-0.0,-0.05,-0.0],"t":-0.0,"x":-10.0}"#),
+            r#"{"q":[0.0,-0.05,0.0],"t":0.0,"x":-10.0}"#
+        );
+    }
 
     #[test]
     fn overrides_name_the_declared_parameters() {
