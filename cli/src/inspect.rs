@@ -40,6 +40,9 @@ pub struct Summary {
     pub length_scale: f64,
     /// Parameters with their defaults, in declaration order.
     pub parameters: Vec<Parameter>,
+    /// Derived parameters (computed from the others), with their values at the defaults.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub derived_parameters: Vec<Parameter>,
     /// Branch invariants as written.
     pub branches: Vec<Branch>,
     /// For a scene that computes forces: what produces them and the reactions it reports.
@@ -123,6 +126,14 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
             .map(|p| Parameter {
                 name: p.name.to_string(),
                 default: p.default,
+            })
+            .collect(),
+        derived_parameters: model
+            .derived
+            .iter()
+            .map(|d| Parameter {
+                name: d.name.to_string(),
+                default: mechgen::interpret::eval(&model.arena, d.value, &env),
             })
             .collect(),
         branches: model
@@ -222,6 +233,24 @@ fn write_report(out: &mut String, scene: &Scene, s: &Summary, stats: bool) -> fm
         writeln!(out, "\nparameters ({}):", s.parameters.len())?;
         let width = s.parameters.iter().map(|p| p.name.len()).max();
         for p in &s.parameters {
+            writeln!(
+                out,
+                "  {:<w$} = {}",
+                p.name,
+                p.default,
+                w = width.unwrap_or(0)
+            )?;
+        }
+    }
+
+    if !s.derived_parameters.is_empty() {
+        writeln!(
+            out,
+            "derived parameters ({}), computed from those above:",
+            s.derived_parameters.len()
+        )?;
+        let width = s.derived_parameters.iter().map(|p| p.name.len()).max();
+        for p in &s.derived_parameters {
             writeln!(
                 out,
                 "  {:<w$} = {}",

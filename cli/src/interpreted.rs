@@ -30,6 +30,8 @@ pub struct Interpreted {
     equations: Vec<String>,
     param_names: Vec<String>,
     params: Vec<f64>,
+    /// Derived parameters (computed from the others, substituted into every tape).
+    derived_names: Vec<String>,
     guess: Tape,
     phi: Tape,
     jacobian: Tape,
@@ -329,6 +331,7 @@ impl Interpreted {
             equations: model.equation_names(),
             param_names: model.params.iter().map(|p| p.name.to_string()).collect(),
             params: model.params.iter().map(|p| p.default).collect(),
+            derived_names: model.derived.iter().map(|d| d.name.to_string()).collect(),
             guess,
             phi,
             jacobian,
@@ -364,6 +367,11 @@ impl Interpreted {
                 values: vec![0.0; values],
             }),
         }
+    }
+
+    /// The derived parameters' names: computed from the others, not settable.
+    pub fn derived_parameter_names(&self) -> &[String] {
+        &self.derived_names
     }
 
     /// The mechanism's name as declared.

@@ -61,6 +61,13 @@ pub fn apply_sets(mechanism: &mut Interpreted, sets: &[(String, f64)]) -> Result
         let names: Vec<&str> = (0..mechanism.parameter_count())
             .filter_map(|i| mechanism.parameter_name(i))
             .collect();
+        if mechanism.derived_parameter_names().contains(name) {
+            return Err(SetError::Unknown(format!(
+                "`--set {name}={value}`: `{name}` is a derived parameter, computed from others \
+                 (`mechgen check FILE` shows it): set the parameters it is computed from; {}",
+                declared_parameters(mechanism)
+            )));
+        }
         if !names.contains(&name.as_str()) {
             let hint = mechgen::check::did_you_mean(name, names.iter().copied())
                 .map(|close| format!("did you mean `{close}`? "))

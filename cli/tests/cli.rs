@@ -229,6 +229,19 @@ fn unknown_parameters_list_the_declared_ones() {
     assert_eq!(out.status.code(), Some(2));
     let message = text(&out.stderr);
     assert!(message.contains("did you mean `omega`?"), "{message}");
+    // A derived parameter is named as such; the parameters it is computed from can be set.
+    let derived = concat!(env!("CARGO_MANIFEST_DIR"), "/../tests/data/derived.mech");
+    let out = mechgen(&["solve", derived, "--at", "0", "--set", "c=40"]);
+    assert_eq!(out.status.code(), Some(2));
+    let message = text(&out.stderr);
+    assert!(message.contains("`c` is a derived parameter"), "{message}");
+    let out = mechgen(&["solve", derived, "--at", "0", "--set", "a=22"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let check = text(&mechgen(&["check", derived]).stdout);
+    assert!(
+        check.contains("derived parameters (2), computed from those above:\n  c    = 38.83"),
+        "{check}"
+    );
 }
 
 #[test]

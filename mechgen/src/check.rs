@@ -12,7 +12,7 @@ mod library;
 
 pub use constant::constant_value;
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use proc_macro2::Span;
 use syn::Ident;
@@ -20,7 +20,9 @@ use syn::Ident;
 use crate::error::Errors;
 use crate::expr::{Arena, Id, Node, Var};
 use crate::graph::{self, UNMATCHED};
-use crate::model::{Body, Branch, Constraint, ConstraintKind, Model, Outputs, Param, Point};
+use crate::model::{
+    Body, Branch, Constraint, ConstraintKind, Derived, Model, Outputs, Param, Point,
+};
 use crate::resolution::{self, Lengths};
 use crate::spec::{BinOp, BranchDecl, Expr, ExprKind, PointRef, Spec};
 
@@ -45,6 +47,8 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
         arena,
         bodies: HashMap::new(),
         params: HashMap::new(),
+        derived: HashMap::new(),
+        computing: None,
         prismatic: HashMap::new(),
         ground: Vec::new(),
         lengths: Lengths::default(),
@@ -52,15 +56,7 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
     cx.check_names(spec);
     let outputs = cx.outputs(spec);
 
-    let params: Vec<Param> = spec
-        .params
-        .iter()
-        .map(|p| Param {
-            name: p.name.clone(),
-            docs: p.docs.clone(),
-            default: cx.constant(&p.default),
-        })
-        .collect();
+    let (params, derived) = cx.parameters(spec);
     cx.ground = spec.bodies.iter().map(|b| b.ground).collect();
 
     let bodies: Vec<Body> = spec
@@ -136,6 +132,7 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
         name: spec.name.clone(),
         arena: std::mem::take(&mut cx.arena),
         params,
+        derived,
         bodies,
         constraints,
         branches,
@@ -158,6 +155,11 @@ struct Checker {
     arena: Arena,
     bodies: HashMap<String, usize>,
     params: HashMap<String, u32>,
+    /// Derived parameters: their value once lowered, `None` while not yet (declared later, or
+    /// the one being lowered).
+    derived: HashMap<String, Option<Id>>,
+    /// The derived parameter being lowered.
+    computing: Option<String>,
     /// Prismatic joints by name, for `travel` drivers: (a, b, unit axis).
     prismatic: HashMap<String, (Point, Point, [Id; 2])>,
     ground: Vec<bool>,
@@ -210,9 +212,21 @@ impl Checker {
         for (i, body) in spec.bodies.iter().enumerate() {
             self.bodies.entry(body.name.to_string()).or_insert(i);
         }
-        for (i, param) in spec.params.iter().enumerate() {
-            let index = crate::expr::var_index(i);
-            self.params.entry(param.name.to_string()).or_insert(index);
+        // A parameter whose default names another is derived; the others are run-time
+        // parameters, indexed in declaration order.
+        let declared: HashSet<String> = spec.params.iter().map(|p| p.name.to_string()).collect();
+        let mut index = 0;
+        for param in &spec.params {
+            let key = param.name.to_string();
+            if self.params.contains_key(&key) || self.derived.contains_key(&key) {
+                continue;
+            }
+            if names_any(&param.default, &declared) {
+                self.derived.insert(key, None);
+            } else {
+                self.params.insert(key, crate::expr::var_index(index));
+                index += 1;
+            }
         }
         if !spec.bodies.iter().any(|b| !b.ground) {
             self.errors.push(
@@ -523,6 +537,33 @@ impl Checker {
         }
     }
 
+    /// The run-time parameters with their defaults, and the derived ones lowered in declaration
+    /// order (each may use run-time parameters and derived ones declared before it).
+    fn parameters(&mut self, spec: &Spec) -> (Vec<Param>, Vec<Derived>) {
+        let (mut params, mut derived) = (Vec::new(), Vec::new());
+        for p in &spec.params {
+            let key = p.name.to_string();
+            if self.derived.get(&key) == Some(&None) {
+                self.computing = Some(key.clone());
+                let value = self.lower_with(&p.default, true, false);
+                self.computing = None;
+                self.derived.insert(key, Some(value));
+                derived.push(Derived {
+                    name: p.name.clone(),
+                    docs: p.docs.clone(),
+                    value,
+                });
+            } else if params.len() < self.params.len() {
+                params.push(Param {
+                    name: p.name.clone(),
+                    docs: p.docs.clone(),
+                    default: self.constant(&p.default),
+                });
+            }
+        }
+        (params, derived)
+    }
+
     /// A parameter default: a constant expression.
     fn constant(&mut self, e: &Expr) -> f64 {
         let before = self.errors.len();
@@ -613,6 +654,9 @@ impl Checker {
                     }
                     return self.arena.var(Var::T);
                 }
+                if let Some(&value) = self.derived.get(&key) {
+                    return self.derived_value(name, value, allow_params);
+                }
                 match self.params.get(&key) {
                     Some(&index) if allow_params => self.arena.param(index),
                     Some(_) => {
@@ -692,6 +736,52 @@ impl Checker {
                 self.arena.zero()
             }
         }
+    }
+}
+
+impl Checker {
+    /// A use of derived parameter `name`: its value, or an error where that cannot be (in a
+    /// parameter's constant default, or before the derived parameter is computed).
+    fn derived_value(&mut self, name: &Ident, value: Option<Id>, allow_params: bool) -> Id {
+        match value {
+            Some(value) if allow_params => value,
+            Some(_) => {
+                self.errors.push(
+                    name.span(),
+                    "a parameter default must be a number, not another parameter",
+                );
+                self.arena.zero()
+            }
+            None => {
+                let message = if self.computing.as_ref() == Some(&name.to_string()) {
+                    format!(
+                        "`{name}` is computed from itself: compute it from other parameters, \
+                         or give it a number to make it a parameter set at run time"
+                    )
+                } else {
+                    format!(
+                        "`{name}` is computed from other parameters and is declared after this \
+                         use: a parameter can only be computed from parameters declared before \
+                         it; move `param {name} = …;` up, or write its expression out"
+                    )
+                };
+                self.errors.push(name.span(), message);
+                self.arena.zero()
+            }
+        }
+    }
+}
+
+/// Whether `e` names any of `names` (function names excluded).
+fn names_any(e: &Expr, names: &HashSet<String>) -> bool {
+    match &e.kind {
+        ExprKind::Number(_) => false,
+        ExprKind::Name(name) => names.contains(&name.to_string()),
+        ExprKind::Neg(a) | ExprKind::Pow(a, _) => names_any(a, names),
+        ExprKind::Binary(_, a, b) | ExprKind::RealPow(a, b) => {
+            names_any(a, names) || names_any(b, names)
+        }
+        ExprKind::Call(_, args) | ExprKind::Tuple(args) => args.iter().any(|a| names_any(a, names)),
     }
 }
 

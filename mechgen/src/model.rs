@@ -21,6 +21,10 @@ pub struct Model {
     pub arena: Arena,
     /// Run-time parameters, by index.
     pub params: Vec<Param>,
+    /// Derived parameters (`param c = sqrt(a^2 + b^2);`), in declaration order: expressions of
+    /// the run-time parameters, substituted wherever they are used (so they follow any change
+    /// of those), and not settable themselves.
+    pub derived: Vec<Derived>,
     /// Bodies in q order: body i owns coordinates 3i, 3i+1, 3i+2.
     pub bodies: Vec<Body>,
     /// Constraints in equation order: ground bodies, then joints, then drivers.
@@ -82,6 +86,17 @@ pub struct Param {
     pub docs: Vec<Attribute>,
     /// Default value.
     pub default: f64,
+}
+
+/// A derived parameter: a name for an expression of the run-time parameters.
+#[derive(Clone)]
+pub struct Derived {
+    /// Name (also the generated accessor method).
+    pub name: Ident,
+    /// Doc comments.
+    pub docs: Vec<Attribute>,
+    /// Its value, in the run-time parameters.
+    pub value: Id,
 }
 
 /// A body.

@@ -31,6 +31,8 @@ pub fn constant_value(text: &str) -> Result<f64, String> {
         arena: Arena::new(),
         bodies: HashMap::new(),
         params: HashMap::new(),
+        derived: HashMap::new(),
+        computing: None,
         prismatic: HashMap::new(),
         ground: Vec::new(),
         lengths: Lengths::default(),

@@ -108,6 +108,7 @@ impl Context<'_> {
             let (name, value) = (&p.name, f64_literal(p.default));
             quote! { #name: #value, }
         });
+        let derived = self.derived_accessors();
         quote! {
             #(#docs)*
             #[derive(Debug, Clone, Copy, PartialEq)]
@@ -119,6 +120,43 @@ impl Context<'_> {
                 fn default() -> Self {
                     Self { #(#defaults)* }
                 }
+            }
+
+            #derived
+        }
+    }
+
+    /// One method per derived parameter, computing it from the fields (so it follows them).
+    fn derived_accessors(&self) -> TokenStream {
+        let model = self.model;
+        if model.derived.is_empty() {
+            return TokenStream::new();
+        }
+        let methods = model.derived.iter().map(|d| {
+            let (docs, name) = (&d.docs, &d.name);
+            let body = if model.arena.is_zero(d.value) {
+                quote!(0.0)
+            } else {
+                self.function(&[(TokenStream::new(), d.value)], TokenStream::new(), &computed())
+                    .body
+            };
+            let doc = format!(
+                " Derived parameter `{name}`: computed from the parameters (set those to change it)."
+            );
+            let separator = (!docs.is_empty()).then(|| quote!(#[doc = ""]));
+            quote! {
+                #(#docs)*
+                #separator
+                #[doc = #doc]
+                pub fn #name(&self) -> f64 {
+                    #body
+                }
+            }
+        });
+        let name = &model.name;
+        quote! {
+            impl #name {
+                #(#methods)*
             }
         }
     }
