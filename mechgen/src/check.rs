@@ -9,6 +9,7 @@ mod constant;
 mod dynamics;
 mod functions;
 mod library;
+mod points;
 
 pub use constant::constant_value;
 
@@ -42,13 +43,18 @@ pub fn check(spec: &Spec) -> Result<Model, Errors> {
 /// # Errors
 /// As [`check`].
 pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
+    // Named points are replaced by what they name before anything else looks at the spec.
+    let mut errors = Errors::default();
+    let substituted = points::substitute(spec, &mut errors);
+    let spec = substituted.as_ref().unwrap_or(spec);
     let mut cx = Checker {
-        errors: Errors::default(),
+        errors,
         arena,
         bodies: HashMap::new(),
         params: HashMap::new(),
         derived: HashMap::new(),
         computing: None,
+        points: HashMap::new(),
         prismatic: HashMap::new(),
         ground: Vec::new(),
         lengths: Lengths::default(),
@@ -160,6 +166,8 @@ struct Checker {
     derived: HashMap<String, Option<Id>>,
     /// The derived parameter being lowered.
     computing: Option<String>,
+    /// Named points, with the names of their bodies.
+    points: HashMap<String, String>,
     /// Prismatic joints by name, for `travel` drivers: (a, b, unit axis).
     prismatic: HashMap<String, (Point, Point, [Id; 2])>,
     ground: Vec<bool>,
@@ -182,7 +190,8 @@ impl Checker {
             .chain(spec.drivers.iter().map(|d| (&d.name, "driver")))
             .chain(spec.branches.iter().map(|b| (&b.name, "branch")))
             .chain(spec.loads.iter().map(|l| (&l.name, "load")))
-            .chain(spec.markers.iter().map(|m| (&m.name, "marker")));
+            .chain(spec.markers.iter().map(|m| (&m.name, "marker")))
+            .chain(spec.points.iter().map(|p| (&p.name, "point")));
         for (name, what) in names {
             let key = name.to_string();
             if key == "t" || key == "pi" {
@@ -202,7 +211,7 @@ impl Checker {
                     name.span(),
                     format!(
                         "duplicate name `{key}`: a {first} of that name is declared above; \
-                         every parameter, body, joint, driver, branch, load and marker needs its own name"
+                         every parameter, body, joint, driver, branch, load, marker and point needs its own name"
                     ),
                 );
             } else {
@@ -211,6 +220,11 @@ impl Checker {
         }
         for (i, body) in spec.bodies.iter().enumerate() {
             self.bodies.entry(body.name.to_string()).or_insert(i);
+        }
+        for point in &spec.points {
+            self.points
+                .entry(point.name.to_string())
+                .or_insert_with(|| point.point.body.to_string());
         }
         // A parameter whose default names another is derived; the others are run-time
         // parameters, indexed in declaration order.
@@ -301,7 +315,12 @@ impl Checker {
 
     fn body(&mut self, name: &Ident) -> Option<usize> {
         let found = self.bodies.get(&name.to_string()).copied();
-        if found.is_none() {
+        if let (None, Some(body)) = (found, self.points.get(&name.to_string())) {
+            self.errors.push(
+                name.span(),
+                format!("`{name}` is a named point (of `{body}`), not a body: name the body here"),
+            );
+        } else if found.is_none() {
             let known: Vec<String> = {
                 let mut v: Vec<(&String, &usize)> = self.bodies.iter().collect();
                 v.sort_by_key(|(_, i)| **i);

@@ -11,8 +11,8 @@ use syn::{Attribute, Ident, LitFloat, LitInt, Token, Visibility, braced, parenth
 
 use crate::spec::{
     BinOp, BodyDecl, BranchDecl, DriverDecl, DriverKind, Expr, ExprKind, GravityDecl, JointDecl,
-    JointKind, LoadDecl, LoadKind, MarkerDecl, MarkerKind, MassDecl, ParamDecl, PointRef, Product,
-    Sign, Spec,
+    JointKind, LoadDecl, LoadKind, MarkerDecl, MarkerKind, MassDecl, ParamDecl, PointDecl,
+    PointRef, Product, Sign, Spec,
 };
 
 mod kw {
@@ -34,6 +34,7 @@ mod kw {
     syn::custom_keyword!(gravity);
     syn::custom_keyword!(load);
     syn::custom_keyword!(marker);
+    syn::custom_keyword!(point);
     syn::custom_keyword!(stiffness);
     syn::custom_keyword!(length);
     syn::custom_keyword!(damping);
@@ -88,6 +89,7 @@ impl Spec {
             gravity: None,
             loads: Vec::new(),
             markers: Vec::new(),
+            points: Vec::new(),
             outputs: None,
         }
     }
@@ -255,6 +257,12 @@ pub(crate) fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> 
             MarkerKind::Point(input.parse()?)
         };
         spec.markers.push(MarkerDecl { docs, name, kind });
+    } else if look.peek(kw::point) {
+        input.parse::<kw::point>()?;
+        let name = input.parse()?;
+        input.parse::<Token![:]>()?;
+        let point = input.parse()?;
+        spec.points.push(PointDecl { docs, name, point });
     } else if look.peek(kw::load) {
         input.parse::<kw::load>()?;
         let name = input.parse()?;

@@ -30,6 +30,8 @@ pub struct Spec {
     pub loads: Vec<LoadDecl>,
     /// Markers (tracked points, angle sensors) in declaration order.
     pub markers: Vec<MarkerDecl>,
+    /// Named body points (`point pin: crank @ (0, 43);`), in declaration order.
+    pub points: Vec<PointDecl>,
     /// The `outputs …;` statement, if any: the listed names with their spans.
     pub outputs: Option<Vec<proc_macro2::Ident>>,
 }
@@ -161,7 +163,20 @@ pub enum LoadKind {
     },
 }
 
-/// A body-fixed point: `rod @ (41.3, 0)`, or `rod` alone for its reference point.
+/// `point pin: crank @ (0, 43);`: a body point written once and used by name (`pin`) wherever a
+/// point is written.
+#[derive(Clone)]
+pub struct PointDecl {
+    /// Doc comments (documentation only: a point generates nothing).
+    pub docs: Vec<Attribute>,
+    /// Its name.
+    pub name: Ident,
+    /// The point.
+    pub point: PointRef,
+}
+
+/// A body-fixed point: `rod @ (41.3, 0)`, or `rod` alone for its reference point (or a named
+/// point's name, replaced by the point before checking).
 #[derive(Clone)]
 pub struct PointRef {
     /// The body the point is fixed to.

@@ -33,6 +33,7 @@ pub fn constant_value(text: &str) -> Result<f64, String> {
         params: HashMap::new(),
         derived: HashMap::new(),
         computing: None,
+        points: HashMap::new(),
         prismatic: HashMap::new(),
         ground: Vec::new(),
         lengths: Lengths::default(),
