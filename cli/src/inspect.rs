@@ -125,7 +125,7 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
             .iter()
             .map(|p| Parameter {
                 name: p.name.to_string(),
-                default: p.default,
+                default: p.default + 0.0,
             })
             .collect(),
         derived_parameters: model
@@ -133,7 +133,7 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
             .iter()
             .map(|d| Parameter {
                 name: d.name.to_string(),
-                default: mechgen::interpret::eval(&model.arena, d.value, &env),
+                default: mechgen::interpret::eval(&model.arena, d.value, &env) + 0.0,
             })
             .collect(),
         branches: model
@@ -151,9 +151,10 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
                 .filter(|b| b.mass.is_some())
                 .map(|b| b.name.to_string())
                 .collect(),
+            // `+ 0.0`: no `-0` in the report (a gravity `(0, -9810)` folds its x to −0).
             gravity: model
                 .gravity
-                .map(|g| mechgen::interpret::eval(&model.arena, g, &env)),
+                .map(|g| mechgen::interpret::eval(&model.arena, g, &env) + 0.0),
             loads: model.loads.iter().map(|l| l.name.clone()).collect(),
             reactions: model.reaction_names(),
         }),

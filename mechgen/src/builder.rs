@@ -219,7 +219,8 @@ impl SceneBuilder {
     }
 
     /// `param NAME = DEFAULT;`: a run-time parameter (a field of the generated struct) with its
-    /// default, a number or a constant expression.
+    /// default, a number or a constant expression; or, when the expression names other
+    /// parameters, a derived parameter computed from them (see the grammar).
     pub fn param(&mut self, name: &str, default: impl Into<Value>) -> &mut Self {
         let what = format!("parameter `{name}`");
         self.check_name(name, &what);
@@ -955,6 +956,26 @@ mod tests {
             // Bit-exact, except that the checker folds `-0.0` to `0.0` (equal as numbers).
             assert!(param.default == x && (x == 0.0 || param.default.to_bits() == x.to_bits()));
         }
+    }
+
+    #[test]
+    fn derived_parameters_are_built_from_expressions() {
+        let mut scene = SceneBuilder::new("Derived");
+        scene.param("a", 3.0).param("b", 4.0).param("c", "sqrt(a^2 + b^2)");
+        scene.ground("frame", [0.0, 0.0, 0.0]);
+        scene.body("b1", [0.0, 0.0, 0.0]);
+        scene.revolute("pin", "frame", ("b1", [0.0, 0.0]));
+        scene.driver_angle("d", "b1", "c * t");
+        let text = scene.build().unwrap_or_else(|e| panic!("{e}"));
+        let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let model = &compiled.model;
+        assert_eq!(model.params.len(), 2);
+        assert_eq!(model.derived.len(), 1);
+        let env = crate::interpret::Env {
+            params: vec![3.0, 4.0],
+            ..Default::default()
+        };
+        assert_eq!(crate::interpret::eval(&model.arena, model.derived[0].value, &env), 5.0);
     }
 
     #[test]
