@@ -961,7 +961,10 @@ mod tests {
     #[test]
     fn derived_parameters_are_built_from_expressions() {
         let mut scene = SceneBuilder::new("Derived");
-        scene.param("a", 3.0).param("b", 4.0).param("c", "sqrt(a^2 + b^2)");
+        scene
+            .param("a", 3.0)
+            .param("b", 4.0)
+            .param("c", "sqrt(a^2 + b^2)");
         scene.ground("frame", [0.0, 0.0, 0.0]);
         scene.body("b1", [0.0, 0.0, 0.0]);
         scene.revolute("pin", "frame", ("b1", [0.0, 0.0]));
@@ -975,7 +978,10 @@ mod tests {
             params: vec![3.0, 4.0],
             ..Default::default()
         };
-        assert_eq!(crate::interpret::eval(&model.arena, model.derived[0].value, &env), 5.0);
+        assert_eq!(
+            crate::interpret::eval(&model.arena, model.derived[0].value, &env),
+            5.0
+        );
     }
 
     #[test]
