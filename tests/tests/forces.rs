@@ -4,9 +4,10 @@
 //!   (`mechgen_examples::inverse_dynamics`), generated and dense-reference solves alike;
 //! - the driver's power against the rate of change of kinetic and potential energy along the
 //!   closed-form motion;
-//! - Newton–Euler for every body of scenes using every joint, driver and load kind: gravity,
-//!   loads, springs and the reported reactions balance `m a_c` and `J θ̈` (a checker built
-//!   from the scene's model, independent of the generator's force derivation);
+//! - Newton–Euler for every body of scenes using every joint, driver and load kind
+//!   (`newton_euler/corpus.rs`), generated and interpreted: gravity, loads, springs and the
+//!   reported reactions balance `m a_c` and `J θ̈` (a checker built from the scene's model,
+//!   independent of the generator's force derivation: `newton_euler`);
 //! - a slider-crank with offset centres of mass against its closed-form inverse dynamics,
 //!   written out here;
 //! - a spring-damper on a slider against hand-derived forces;
@@ -23,7 +24,7 @@ use mechgen_runtime::{
     Dense, Forces, Quantity, Simulation, SolveError, Solver, SolverOptions, State, Structured,
     mechanism,
 };
-use mechgen_tests::twin;
+use newton_euler::corpus::{Actuators, Carriage, GearTrain, Scene, Sink, Yoke};
 use num_dual::{Dual2_64, DualNum, second_derivative};
 
 fn read_scene(file: &str) -> String {
@@ -157,20 +158,32 @@ fn driver_power_balances_the_energy_rate() {
     assert!(worst <= 1e-10 * largest, "{worst:e} of {largest:e}");
 }
 
-/// Steps a `.mech` scene with the interpreter and checks Newton–Euler at every state.
-fn assert_newton_euler(source: &str, t_end: f64, steps: usize) {
-    let scene = mechgen::compile_str(source).unwrap_or_else(|e| panic!("{e}"));
-    let mechanism = Interpreted::new(&scene);
+/// Steps `mechanism` (an implementation of `scene`) and checks Newton–Euler at every state.
+fn newton_euler_along<M: Structured + Forces>(
+    scene: &mechgen::Scene,
+    mechanism: M,
+    t_end: f64,
+    steps: usize,
+) -> f64
+where
+    mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
+{
     let mut simulation = Simulation::new(Solver::new(mechanism), 0.0).expect("assembles");
-    let mut worst = 0.0f64;
     let mut states = Vec::new();
     simulation
         .run(t_end, steps, |state| states.push(state.clone()))
         .expect("solves");
     let mechanism = simulation.solver().mechanism();
-    for state in &states {
-        worst = worst.max(newton_euler::residual(&scene, mechanism, state));
-    }
+    states
+        .iter()
+        .map(|state| newton_euler::residual(scene, mechanism, state))
+        .fold(0.0, f64::max)
+}
+
+/// Steps a `.mech` scene with the interpreter and checks Newton–Euler at every state.
+fn assert_newton_euler(source: &str, t_end: f64, steps: usize) {
+    let scene = mechgen::compile_str(source).unwrap_or_else(|e| panic!("{e}"));
+    let worst = newton_euler_along(&scene, Interpreted::new(&scene), t_end, steps);
     assert!(worst <= 1e-10, "Newton–Euler residual {worst:e}");
 }
 
@@ -180,50 +193,33 @@ fn newton_euler_balances_every_body_of_the_seed() {
     assert_newton_euler(&read_scene("piston_crank_dynamics.mech"), period, 90);
 }
 
-// Every joint kind, a rotated frame, offset centres of mass, world and body-axis forces, a
-// torque, a spring-damper, and drivers relative to the frame and between bodies.
-twin! {
-    SINK,
-    mechanism Sink {
-        param omega = 3.0;
-        ground frame at (0, 0, 0.1);
-        body crank near (4.8, 2.5, 0) mass 1.5 inertia 40 centre (10, 3);
-        body slider near (110, 5, 0.1) mass 0.8 inertia 5 centre (2, -1);
-        body arm near (115, 5, 0.1) mass 0.6 inertia 30 centre (0, 10);
-        joint pivot: revolute(frame @ (5, 2), crank);
-        joint rod: distance(crank @ (30, 0), slider @ (0, 3), 80);
-        joint guide: prismatic(frame @ (0, -10), slider, along (2, 0.3));
-        joint hinge: revolute(slider @ (5, 0), arm);
-        driver spin: relative_angle(frame, crank) = omega * t;
-        driver wave: relative_angle(slider, arm) = 0.3 * sin(5 * t);
-        gravity (0.5, -9.81);
-        load push: force(slider @ (1, 1)) = (3 * sin(t), 2);
-        load thrust: local_force(arm @ (0, 20)) = (0, 4);
-        load brake: torque(crank) = -0.2 * t;
-        load coil: spring(frame @ (50, 40), arm @ (0, 20), stiffness 2, length 30, damping 0.05);
-    }
-}
-
-// A travel driver and an x driver, a damper alone, a frame turned the other way.
-twin! {
-    CARRIAGE,
-    mechanism Carriage {
-        ground frame at (3, -2, -0.2);
-        body carriage near (3, -2, -0.2) mass 2 inertia 10 centre (1, 0.5);
-        body pendulum near (3, -2, -0.2) mass 0.5 inertia 8 centre (0, -15);
-        joint guide: prismatic(frame, carriage, along (1, 1));
-        joint hinge: revolute(carriage, pendulum);
-        driver stroke: travel(guide) = 20 * sin(2 * t);
-        driver sway: x(pendulum @ (0, -30)) = 3 - 5 * sin(1.5 * t) + 12 * sin(2 * t);
-        gravity (0, -9.81);
-        load drag: spring(frame @ (0, 40), pendulum @ (0, -30), damping 0.3);
-    }
+/// A corpus scene, interpreted and generated, along its motion.
+fn assert_newton_euler_both<S: Scene + Structured + Forces>(steps: usize)
+where
+    mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<S::Dim>,
+{
+    let scene = mechgen::compile_str(S::TEXT).unwrap_or_else(|e| panic!("{e}"));
+    let name = scene.model.name.to_string();
+    let worst = newton_euler_along(&scene, S::default(), S::T_END, steps);
+    assert!(
+        worst <= 1e-10,
+        "{name} (generated): Newton–Euler residual {worst:e}"
+    );
+    assert_newton_euler(S::TEXT, S::T_END, steps);
 }
 
 #[test]
 fn newton_euler_balances_every_joint_driver_and_load_kind() {
-    assert_newton_euler(SINK, 2.0, 60);
-    assert_newton_euler(CARRIAGE, 3.0, 60);
+    // Revolute, distance, prismatic; relative_angle drivers; forces, a torque, a spring-damper.
+    assert_newton_euler_both::<Sink>(60);
+    // Travel and x drivers, a damper.
+    assert_newton_euler_both::<Carriage>(60);
+    // Slot, weld, rack; an angle driver.
+    assert_newton_euler_both::<Yoke>(60);
+    // Gears with and without a carrier; a y driver.
+    assert_newton_euler_both::<GearTrain>(60);
+    // Distance and slide drivers.
+    assert_newton_euler_both::<Actuators>(60);
 }
 
 /// The reactions along `steps` steps of a simulation to `t_end`, as rows.
@@ -250,7 +246,7 @@ fn generated_force_solve_matches_the_interpreter_across_blocks() {
     };
     let error = relative_error(
         &reaction_rows(Sink::default(), 2.0, 60),
-        &reaction_rows(interpreted(SINK), 2.0, 60),
+        &reaction_rows(interpreted(Sink::TEXT), 2.0, 60),
         1.0,
     );
     assert!(
@@ -259,7 +255,7 @@ fn generated_force_solve_matches_the_interpreter_across_blocks() {
     );
     let error = relative_error(
         &reaction_rows(Carriage::default(), 3.0, 60),
-        &reaction_rows(interpreted(CARRIAGE), 3.0, 60),
+        &reaction_rows(interpreted(Carriage::TEXT), 3.0, 60),
         1.0,
     );
     assert!(

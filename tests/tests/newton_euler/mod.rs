@@ -8,6 +8,8 @@
 //! not use the generator's derivation of F or of the multipliers, so a sign or a lever arm
 //! wrong there shows as a residual here.
 
+pub mod corpus;
+
 use mechgen::model::{ConstraintKind, Driven, LoadKind, Point};
 use mechgen_runtime::{Forces, State, Storage, nalgebra::DefaultAllocator};
 
