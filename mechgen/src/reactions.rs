@@ -404,7 +404,59 @@ fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
 
 #[cfg(test)]
 mod tests {
-    use super::resolution_order;
+    use super::{ForceStage, assert_reads_later_stages, resolution_order};
+    use crate::expr::{Var, var_index};
+    use crate::structure::Stage;
+
+    /// Issue 20's first scene: its fixed stage holds the prismatic joint's two equations.
+    const PRISMATIC_TORQUE: &str = "mechanism PrismaticTorque {
+        ground frame at (0, 0, 0);
+        body slider near (6, 0, 0);
+        joint slide: prismatic(frame, slider @ (-6, 0), along (1, 0));
+        driver s: travel(slide) = t;
+        load push: force(slider) = (0, 100 * t);
+    }";
+
+    /// The scene's force stages with the first multiplier of stage `s` made to read the
+    /// multiplier of `equation`, checked.
+    fn check_with_read(s: usize, equation: impl Fn(&[Stage]) -> usize) {
+        let mut scene = crate::compile_str(PRISMATIC_TORQUE).unwrap_or_else(|e| panic!("{e}"));
+        let mut stages = scene.forces.expect("computes forces").stages;
+        let n = scene.kinematics.phi.len();
+        let read = equation(&scene.plan.stages);
+        let lambda = scene.model.arena.var(Var::Lambda(var_index(read)));
+        let (ForceStage::Explicit(values) | ForceStage::Block(values)) = &mut stages[s];
+        values[0] = scene.model.arena.add(values[0], lambda);
+        assert_reads_later_stages(&scene.model.arena, &scene.plan, &stages, n);
+    }
+
+    fn first_equation(stage: &Stage) -> usize {
+        match stage {
+            Stage::Explicit(assignments) => assignments[0].equation,
+            Stage::Block(block) => block.equations[0],
+        }
+    }
+
+    #[test]
+    fn the_planned_stages_read_only_later_multipliers() {
+        let scene = crate::compile_str(PRISMATIC_TORQUE).unwrap_or_else(|e| panic!("{e}"));
+        let stages = scene.forces.expect("computes forces").stages;
+        assert!(stages.len() >= 2, "a fixed stage and the driver's");
+        let n = scene.kinematics.phi.len();
+        assert_reads_later_stages(&scene.model.arena, &scene.plan, &stages, n);
+    }
+
+    #[test]
+    #[should_panic(expected = "before the reverse sweep computes it")]
+    fn a_kernel_reading_its_own_stage_multiplier_is_refused() {
+        check_with_read(0, |stages| first_equation(&stages[0]));
+    }
+
+    #[test]
+    #[should_panic(expected = "before the reverse sweep computes it")]
+    fn a_kernel_reading_an_earlier_stage_multiplier_is_refused() {
+        check_with_read(1, |stages| first_equation(&stages[0]));
+    }
 
     #[test]
     fn multipliers_resolve_after_those_they_read() {

@@ -502,3 +502,36 @@ fn a_zero_length_spring_stays_finite_where_its_ends_meet() {
         );
     }
 }
+
+#[test]
+fn force_kernels_read_their_angles_from_the_trig_cache() {
+    // Only the force solve needs the crank's sine and cosine (the force's lever arm and the
+    // centre's acceleration): the cache is planned for it too, so the stage that solves the
+    // angle fills it and no force kernel calls `sincos` again.
+    let source = "mechanism LoadedCrank {
+        ground frame at (0, 0, 0);
+        body crank near (0, 0, 0) mass 1 inertia 0.5 centre (0.5, 0.1);
+        joint pivot: revolute(frame, crank);
+        driver spin: angle(crank) = 3 * t;
+        load push: force(crank @ (1, 0)) = (0, 2);
+    }";
+    let scene = mechgen::compile_str(source).unwrap_or_else(|e| panic!("{e}"));
+    let code = mechgen::emit::emit(&scene).to_string();
+    let mut kernels = 0;
+    // Every function body sits between `fn name (` and the next `fn `.
+    for body in code.split(" fn ").skip(1) {
+        let name = body.split_whitespace().next().unwrap_or_default();
+        if name.ends_with("_multipliers") || name.ends_with("_force_rhs") {
+            kernels += 1;
+            assert!(
+                !body.contains("sincos"),
+                "`fn {name}` computes a sine: {body}"
+            );
+            assert!(
+                body.contains("trig"),
+                "`fn {name}` reads no cached angle: {body}"
+            );
+        }
+    }
+    assert!(kernels > 0, "no force kernel in {code}");
+}
