@@ -8,16 +8,21 @@
 //!
 //! - an explicit assignment (equation e assigns coordinate c with constant coefficient a) gives
 //!   `λ_e = (F_c − Σ_{i ≠ e} Φ_q[i, c] λ_i) / a` in closed form; assignments of one stage that
-//!   read each other are resolved in dependency order, so each expression reads only later
+//!   read each other are resolved in their dependency order (found here from the expressions,
+//!   not assumed from the stage's order) and substituted, so each expression reads only later
 //!   stages' multipliers;
 //! - a block's right-hand side is `r_c = F_c − Σ_{i later} Φ_q[i, c] λ_i` per coordinate, and
 //!   the runtime solves `Φ_q[b, b]ᵀ λ_b = r` with the block's static LU.
 //!
 //! Fixed coordinates and constant rates are substituted, so the frame, a driven crank's
-//! constant speed and the like cost nothing. The reported reaction of each equation is then a
-//! simple function of λ: a revolute joint's force on its first body is `−λ`, a prismatic
-//! joint's normal force and torque `λ`, a distance joint's tension `2 L λ`, a driver's effort
-//! `−λ`, and a ground body's load is what the textbook formulation's multiplier would be,
+//! constant speed and the like cost nothing. The plan asserts that no stage's kernel reads a
+//! multiplier the reverse sweep has not computed yet: one that did would read whatever an
+//! earlier solve left in the buffer, and a reaction would depend on which times were solved
+//! before.
+//!
+//! The reported reaction of each equation is then a simple function of λ: a revolute joint's
+//! force on its first body is `−λ`, a prismatic joint's normal force and torque `λ`, a
+//! distance joint's tension `2 L λ`, a driver's effort `−λ`, and a ground body's load is what the textbook formulation's multiplier would be,
 //! `−Σ_i ∂Φ_i/∂q_ground λ_i` (the joints seen through the frame's coordinates), plus the pull
 //! of the springs anchored to it.
 
@@ -90,7 +95,7 @@ pub fn plan(model: &mut Model, kin: &Kinematics, plan: &Plan, generalized: Vec<I
         columns,
         generalized: &generalized,
     };
-    let stages = plan
+    let stages: Vec<ForceStage> = plan
         .stages
         .iter()
         .map(|stage| match stage {
@@ -110,6 +115,7 @@ pub fn plan(model: &mut Model, kin: &Kinematics, plan: &Plan, generalized: Vec<I
             ),
         })
         .collect();
+    assert_reads_later_stages(&model.arena, plan, &stages, n);
     Forces {
         generalized,
         stages,
@@ -170,28 +176,120 @@ impl Transpose<'_> {
     }
 
     /// The multipliers of an explicit stage's (equation, coordinate) assignments, each divided
-    /// by its coefficient and with the stage's own multipliers substituted.
+    /// by its coefficient and with the stage's own multipliers substituted, in the stage's
+    /// assignment order.
     ///
-    /// The forward sweep solved the assignments one after another, so an equation touches only
-    /// its own coordinate and earlier ones: a coordinate's column holds its own equation and
-    /// later ones. In reverse order every multiplier reads only multipliers already resolved.
+    /// Assignment (e, c) reads the multipliers of the stage's other equations that touch c:
+    /// those that read c in the forward sweep. They are resolved first ([`resolution_order`],
+    /// over the entries that survive the known values) and substituted, so every expression
+    /// reads only later stages' multipliers, whatever order the stage lists its assignments in.
     fn explicit(&mut self, assignments: &[(usize, usize)]) -> Vec<Id> {
+        let own: HashMap<Var, usize> = assignments
+            .iter()
+            .enumerate()
+            .map(|(k, &(e, _))| (Var::Lambda(var_index(e)), k))
+            .collect();
+        let raw: Vec<Id> = assignments
+            .iter()
+            .map(|&(e, c)| {
+                let rest = self.remainder(c, &[e]);
+                let coefficient = self.columns[c]
+                    .iter()
+                    .find(|(i, _)| *i == e)
+                    .map(|&(_, v)| v)
+                    .expect("the plan assigns a coordinate through an equation that touches it");
+                let coefficient = self.known(coefficient);
+                divide(self.arena, rest, coefficient)
+            })
+            .collect();
+        let reads: Vec<Vec<usize>> = raw
+            .iter()
+            .map(|&r| {
+                let vars = self.arena.variables(r);
+                vars.iter().filter_map(|v| own.get(v).copied()).collect()
+            })
+            .collect();
+        let order = resolution_order(&reads).unwrap_or_else(|| {
+            panic!(
+                "internal error: the multipliers of the explicit stage {assignments:?} read \
+                 each other in a cycle (the forward sweep's order does not transpose)"
+            )
+        });
         let mut resolved: HashMap<Var, Id> = HashMap::new();
         let mut values = vec![self.arena.zero(); assignments.len()];
-        for (k, &(e, c)) in assignments.iter().enumerate().rev() {
-            let rest = self.remainder(c, &[e]);
-            let coefficient = self.columns[c]
-                .iter()
-                .find(|(i, _)| *i == e)
-                .map(|&(_, v)| v)
-                .expect("the plan assigns a coordinate through an equation that touches it");
-            let coefficient = self.known(coefficient);
-            let raw = divide(self.arena, rest, coefficient);
-            let value = self.arena.substitute(raw, &resolved, &mut HashMap::new());
-            resolved.insert(Var::Lambda(var_index(e)), value);
+        for k in order {
+            let value = self
+                .arena
+                .substitute(raw[k], &resolved, &mut HashMap::new());
+            resolved.insert(Var::Lambda(var_index(assignments[k].0)), value);
             values[k] = value;
         }
         values
+    }
+}
+
+/// An order in which to resolve a stage's multipliers: `reads[k]` lists the assignments whose
+/// multipliers assignment k's expression reads, and each comes before k. Among those ready, the
+/// last in the stage goes first (the reverse of the forward sweep, when that is an order).
+/// `None` if they read each other in a cycle.
+fn resolution_order(reads: &[Vec<usize>]) -> Option<Vec<usize>> {
+    let n = reads.len();
+    let mut waiting: Vec<usize> = reads
+        .iter()
+        .enumerate()
+        .map(|(k, r)| r.iter().filter(|&&i| i != k).count())
+        .collect();
+    let mut readers = vec![Vec::new(); n];
+    for (k, r) in reads.iter().enumerate() {
+        for &i in r.iter().filter(|&&i| i != k) {
+            readers[i].push(k);
+        }
+    }
+    let mut ready: std::collections::BinaryHeap<usize> =
+        (0..n).filter(|&k| waiting[k] == 0).collect();
+    let mut order = Vec::with_capacity(n);
+    while let Some(k) = ready.pop() {
+        order.push(k);
+        for &reader in &readers[k] {
+            waiting[reader] -= 1;
+            if waiting[reader] == 0 {
+                ready.push(reader);
+            }
+        }
+    }
+    (order.len() == n).then_some(order)
+}
+
+/// Asserts what the reverse sweep relies on: every stage's kernel reads only the multipliers
+/// of later stages' equations, which the sweep has written before it runs. A violation is a
+/// bug in the plan or in this module, and would make a reaction depend on which times were
+/// solved before (the buffer still holding an earlier solve's multiplier).
+fn assert_reads_later_stages(arena: &Arena, plan: &Plan, stages: &[ForceStage], n: usize) {
+    let mut stage_of = vec![usize::MAX; n];
+    for (s, stage) in plan.stages.iter().enumerate() {
+        let equations: Vec<usize> = match stage {
+            Stage::Explicit(assignments) => assignments.iter().map(|a| a.equation).collect(),
+            Stage::Block(block) => block.equations.clone(),
+        };
+        for e in equations {
+            stage_of[e] = s;
+        }
+    }
+    for (s, stage) in stages.iter().enumerate() {
+        let (ForceStage::Explicit(values) | ForceStage::Block(values)) = stage;
+        for &value in values {
+            for var in arena.variables(value) {
+                if let Var::Lambda(i) = var {
+                    let i = i as usize;
+                    assert!(
+                        stage_of[i] > s && stage_of[i] != usize::MAX,
+                        "internal error: the force solve's stage {s} reads the multiplier of \
+                         equation {i} (stage {}) before the reverse sweep computes it",
+                        stage_of[i]
+                    );
+                }
+            }
+        }
     }
 }
 
@@ -302,4 +400,78 @@ fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
         }
     }
     loads
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{ForceStage, assert_reads_later_stages, resolution_order};
+    use crate::expr::{Var, var_index};
+    use crate::structure::Stage;
+
+    /// Issue 20's first scene: its fixed stage holds the prismatic joint's two equations.
+    const PRISMATIC_TORQUE: &str = "mechanism PrismaticTorque {
+        ground frame at (0, 0, 0);
+        body slider near (6, 0, 0);
+        joint slide: prismatic(frame, slider @ (-6, 0), along (1, 0));
+        driver s: travel(slide) = t;
+        load push: force(slider) = (0, 100 * t);
+    }";
+
+    /// The scene's force stages with the first multiplier of stage `s` made to read the
+    /// multiplier of `equation`, checked.
+    fn check_with_read(s: usize, equation: impl Fn(&[Stage]) -> usize) {
+        let mut scene = crate::compile_str(PRISMATIC_TORQUE).unwrap_or_else(|e| panic!("{e}"));
+        let mut stages = scene.forces.expect("computes forces").stages;
+        let n = scene.kinematics.phi.len();
+        let read = equation(&scene.plan.stages);
+        let lambda = scene.model.arena.var(Var::Lambda(var_index(read)));
+        let (ForceStage::Explicit(values) | ForceStage::Block(values)) = &mut stages[s];
+        values[0] = scene.model.arena.add(values[0], lambda);
+        assert_reads_later_stages(&scene.model.arena, &scene.plan, &stages, n);
+    }
+
+    fn first_equation(stage: &Stage) -> usize {
+        match stage {
+            Stage::Explicit(assignments) => assignments[0].equation,
+            Stage::Block(block) => block.equations[0],
+        }
+    }
+
+    #[test]
+    fn the_planned_stages_read_only_later_multipliers() {
+        let scene = crate::compile_str(PRISMATIC_TORQUE).unwrap_or_else(|e| panic!("{e}"));
+        let stages = scene.forces.expect("computes forces").stages;
+        assert!(stages.len() >= 2, "a fixed stage and the driver's");
+        let n = scene.kinematics.phi.len();
+        assert_reads_later_stages(&scene.model.arena, &scene.plan, &stages, n);
+    }
+
+    #[test]
+    #[should_panic(expected = "before the reverse sweep computes it")]
+    fn a_kernel_reading_its_own_stage_multiplier_is_refused() {
+        check_with_read(0, |stages| first_equation(&stages[0]));
+    }
+
+    #[test]
+    #[should_panic(expected = "before the reverse sweep computes it")]
+    fn a_kernel_reading_an_earlier_stage_multiplier_is_refused() {
+        check_with_read(1, |stages| first_equation(&stages[0]));
+    }
+
+    #[test]
+    fn multipliers_resolve_after_those_they_read() {
+        // 0 reads 2, 2 reads 1: 1, 2, 0 whatever the stage's order.
+        assert_eq!(
+            resolution_order(&[vec![2], vec![], vec![1]]),
+            Some(vec![1, 2, 0])
+        );
+        // Independent ones go in reverse stage order; reading itself is no dependency.
+        assert_eq!(
+            resolution_order(&[vec![0], vec![], vec![]]),
+            Some(vec![2, 1, 0])
+        );
+        // The fixed stage of a prismatic joint: the angle's multiplier (1) reads the normal's (0).
+        assert_eq!(resolution_order(&[vec![], vec![0]]), Some(vec![0, 1]));
+        assert_eq!(resolution_order(&[vec![1], vec![0]]), None);
+    }
 }

@@ -120,7 +120,10 @@ impl TrigCache {
 /// One stage of the solve.
 #[derive(Debug, Clone)]
 pub enum Stage {
-    /// Coordinates assigned in closed form, in order.
+    /// Coordinates assigned in closed form, in order: each position reads only coordinates
+    /// assigned before it (earlier in the stage, or in earlier stages). The fixed stage's
+    /// positions are constants and are listed by coordinate; through Φ_q its equations may
+    /// still touch each other's coordinates in any order.
     Explicit(Vec<Assignment>),
     /// Equations solved together by Newton's method.
     Block(Block),
@@ -502,6 +505,9 @@ impl Planner<'_> {
                 }
             }
         }
+        // Fixed positions are constants, so any order serves the forward sweep: by coordinate
+        // reads best. The force solve does not rely on it (it resolves the stage's
+        // multipliers in their own dependency order, `reactions`).
         fixed.sort_by_key(|a| a.coordinate);
         fixed
     }
