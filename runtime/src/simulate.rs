@@ -300,7 +300,7 @@ where
                 return Outcome::Jumped;
             }
         }
-        if next.orientation != current.orientation || next.swept {
+        if next.block_signs != current.block_signs || next.swept {
             return Outcome::Crossed;
         }
         self.accept();

@@ -153,6 +153,12 @@ pub struct Convergence {
     /// coefficients). It changes between two solutions only if Φ_q is singular somewhere
     /// between them; [`crate::Simulation`] watches it to catch toggle crossings.
     pub orientation: i8,
+    /// Which blocks have a negative determinant: the XOR of a 64-bit code per such block
+    /// ([`crate::crossing::block_code`], distinct and non-zero for every stage). Two states
+    /// whose blocks' signs differ have a singular configuration between them even when an even
+    /// number of blocks flipped and `orientation` did not change; the codes of two different
+    /// blocks never cancel (three or more could, with a chance of order 2⁻⁶⁴).
+    pub block_signs: u64,
     /// Whether a block's Newton iterates met both determinant signs: the iteration crossed
     /// a singular configuration between its start and the solution.
     pub swept: bool,
@@ -167,11 +173,12 @@ impl Convergence {
             fallbacks: 0,
             evaluations: 0,
             orientation: 1,
+            block_signs: 0,
             swept: false,
         }
     }
 
-    fn add(&mut self, block: &Solved, newton: (usize, usize)) {
+    fn add(&mut self, stage: usize, block: &Solved, newton: (usize, usize)) {
         let (fallbacks, evaluations) = newton;
         self.iterations = self.iterations.max(block.iterations);
         self.residual = self.residual.max(block.residual);
@@ -185,6 +192,7 @@ impl Convergence {
         self.evaluations += evaluations;
         if block.orientation < 0.0 {
             self.orientation = -self.orientation;
+            self.block_signs ^= crate::crossing::block_code(stage);
         }
         self.swept |= block.swept;
     }
@@ -411,6 +419,7 @@ where
         state.evaluations = convergence.evaluations;
         state.fallbacks = convergence.fallbacks;
         state.orientation = convergence.orientation;
+        state.block_signs = convergence.block_signs;
         state.swept = convergence.swept;
         Ok(())
     }
@@ -498,7 +507,7 @@ where
                     let solved = newton
                         .solve(q, rates != Rates::None)
                         .map_err(|e| record(e, m, s, newton.parts, diagnosed))?;
-                    total.add(&solved, (newton.fallbacks, newton.evaluations));
+                    total.add(s, &solved, (newton.fallbacks, newton.evaluations));
                     m.fill_trig(s, q, newton.parts.trig);
                     block_rates(
                         &newton.bs,
