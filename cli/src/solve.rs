@@ -4,7 +4,9 @@
 use std::io::Write;
 
 use mechgen_runtime::nalgebra::DVector;
-use mechgen_runtime::{Mechanism, Simulation, SolveError, Solver, State, write_csv_header};
+use mechgen_runtime::{
+    GUESS_TIME, Mechanism, Simulation, SolveError, Solver, State, write_csv_header,
+};
 
 use crate::Interpreted;
 
@@ -83,10 +85,22 @@ fn declared_parameters(mechanism: &Interpreted) -> String {
 /// The solver's error, described with the scene's names and a hint.
 pub fn assemble(mechanism: Interpreted, t0: f64) -> Result<Simulation<Interpreted>, String> {
     Simulation::new(Solver::new(mechanism), t0).map_err(|failure| {
+        // Between t = 0 and t0 the failure is a step of the motion followed to the start.
+        let time = failure.error.time().unwrap_or(t0);
+        let (context, hint) = if time != t0 && time != GUESS_TIME {
+            (
+                format!(
+                    " at t0 = {t0} (the `near` guesses describe t = 0; following the motion \
+                     from there, it stopped at t = {time})"
+                ),
+                step_hint(&failure.error),
+            )
+        } else {
+            (String::new(), assembly_hint(&failure.error))
+        };
         format!(
-            "cannot assemble `{}`: {failure}\n  hint: {}",
+            "cannot assemble `{}`{context}: {failure}\n  hint: {hint}",
             failure.solver.mechanism().name(),
-            assembly_hint(&failure.error)
         )
     })
 }
@@ -117,6 +131,10 @@ fn assembly_hint(error: &SolveError) -> &'static str {
              positions near the scene's size, and check parameters that set huge values"
         }
         SolveError::Geometry { .. } => GEOMETRY_HINT,
+        SolveError::Unreachable { .. } => {
+            "start the run nearer t = 0 (`--t0`), or write the drivers so that the motion of \
+             interest starts near t = 0"
+        }
         _ => "check the parameter values and the `near` guesses for divisions by zero",
     }
 }

@@ -209,6 +209,18 @@ pub enum SolveError {
         /// What it must be.
         requirement: Requirement,
     },
+    /// [`crate::Simulation::new`] followed the motion from t = 0 (where the `near` guesses
+    /// describe the mechanism) towards the start time for
+    /// [`crate::MAX_CONTINUATION_STEPS`] steps without reaching it: the state there
+    /// cannot be shown to be the one continuous motion reaches.
+    Unreachable {
+        /// The start time asked for.
+        time: f64,
+        /// The time the motion was followed to.
+        reached: f64,
+        /// Steps taken.
+        steps: usize,
+    },
     /// A vector passed in does not have `dim()` entries (only possible with `Dyn` mechanisms).
     DimensionMismatch {
         /// The mechanism's `dim()`.
@@ -251,7 +263,8 @@ impl SolveError {
             | Self::Singular { time, .. }
             | Self::BranchFlip { time, .. }
             | Self::NonFinite { time, .. }
-            | Self::Geometry { time, .. } => Some(time),
+            | Self::Geometry { time, .. }
+            | Self::Unreachable { time, .. } => Some(time),
             Self::DimensionMismatch { .. } => None,
         }
     }
@@ -403,6 +416,16 @@ impl SolveError {
                     requirement.describe()
                 )
             }
+            Self::Unreachable {
+                time,
+                reached,
+                steps,
+            } => write!(
+                f,
+                "the start time t = {time} is out of reach: the `near` guesses describe the \
+                 mechanism at t = 0, and {steps} steps of its motion from there reached only \
+                 t = {reached}; start nearer t = 0"
+            ),
             Self::DimensionMismatch { expected, found } => {
                 write!(
                     f,
