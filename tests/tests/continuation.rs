@@ -5,8 +5,13 @@
 //! intersections of a Peaucellier cell's circles), so a solve that loses the motion lands on a
 //! wrong but valid configuration: only comparing with the motion followed in fine steps shows it.
 
+use mechgen_examples::scenes::{FourBar, PistonCrank};
 use mechgen_runtime::nalgebra::DefaultAllocator;
-use mechgen_runtime::{Simulation, SolveError, Solver, Storage, Structured, mechanism};
+use mechgen_runtime::{
+    Mechanism, Simulation, SolveError, Solver, Storage, Structured, Unit, mechanism,
+};
+use proptest::prelude::*;
+use proptest::test_runner::{RngSeed, TestCaseError};
 
 mechanism! {
     /// A crank whose pin runs in the slot of a lever (the core of a Whitworth quick-return):
@@ -96,4 +101,152 @@ fn the_lever_follows_its_closed_form_along_the_motion() {
             );
         })
         .unwrap();
+}
+
+mechanism! {
+    /// A Whitworth quick-return: the crank is longer than the distance between the pivots, so
+    /// the slotted lever turns fully, and a rod from the lever's far end drives a ram along a
+    /// guide. The lever block and the ram block (rod angle and ram position) each have a mirror.
+    pub mechanism Whitworth {
+        ground frame at (0, 0, 0);
+        body crank near (0, 30, 0);
+        body lever near (0, 0, 0.54);
+        body rod near (-34.3, -20.6, 0.006);
+        body ram near (65.7, -20, 0);
+        joint crank_pivot: revolute(frame @ (0, 30), crank);
+        joint lever_pivot: revolute(frame, lever);
+        joint pin: slot(lever, crank @ (50, 0), along (1, 0));
+        joint tip: revolute(lever @ (-40, 0), rod);
+        joint ram_pin: revolute(rod @ (100, 0), ram);
+        joint guide: prismatic(frame @ (0, -20), ram, along (1, 0));
+        driver spin: angle(crank) = 2 * t;
+    }
+}
+
+mechanism! {
+    /// A Peaucellier–Lipkin cell of distance joints: arms of 2.5 from the origin, a rhombus of
+    /// side 1 whose vertex C the crank carries on a circle through the origin, and P, the
+    /// vertex opposite C, which moves on a straight line. A and B are the two intersections of
+    /// the circles about O and C (one arm on each: both on one is singular), P the second
+    /// intersection of the circles about A and B.
+    pub mechanism Peaucellier {
+        ground frame at (0, 0, 0);
+        body crank near (1.5, 0, 0);
+        body arm_a near (0, 0, 0.41);
+        body arm_b near (0, 0, -0.41);
+        body side near (2.375, 0.78, -2.25);
+        joint crank_pivot: revolute(frame @ (1.5, 0), crank);
+        joint pivot_a: revolute(frame, arm_a);
+        joint pivot_b: revolute(frame, arm_b);
+        joint a_to_c: distance(arm_a @ (2.5, 0), crank @ (1.5, 0), 1);
+        joint b_to_c: distance(arm_b @ (2.5, 0), crank @ (1.5, 0), 1);
+        joint hinge: revolute(arm_a @ (2.5, 0), side);
+        joint p_to_b: distance(side @ (1, 0), arm_b @ (2.5, 0), 1);
+        driver swing: angle(crank) = 1.2 * sin(t);
+    }
+}
+
+/// How the corpus's scenes are sampled: start times in `0..horizon`, the motion followed in
+/// `rate` steps per second for the reference, positions compared to `size` × 1e-8.
+struct Sampling {
+    horizon: f64,
+    rate: f64,
+    size: f64,
+}
+
+/// The state at `t0` three ways: the motion from t = 0 followed in fine steps (the reference),
+/// a simulation started at `t0`, and one started at `t1` (before or after `t0`) and stepped to
+/// `t0`. All three must be the same state, angles with the same winding.
+fn same_state_however_reached<M: Structured + Clone>(
+    scene: M,
+    sampling: &Sampling,
+    t0: f64,
+    t1: f64,
+) -> Result<(), TestCaseError>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let steps = ((t0 * sampling.rate).ceil() as usize).max(1);
+    let reference = stepped(scene.clone(), t0, steps)
+        .map_err(|e| TestCaseError::fail(format!("t0 = {t0}, reference: {e:?}")))?;
+    let direct = Simulation::new(Solver::new(scene.clone()), t0)
+        .map_err(|e| TestCaseError::fail(format!("start at t0 = {t0}: {e}")))?;
+    let mut earlier = Simulation::new(Solver::new(scene.clone()), t1)
+        .map_err(|e| TestCaseError::fail(format!("start at t1 = {t1}: {e}")))?;
+    earlier
+        .step_to(t0)
+        .map_err(|e| TestCaseError::fail(format!("t1 = {t1} to t0 = {t0}: {e:?}")))?;
+    let expected = &reference.state().q;
+    for (how, state) in [
+        ("started at t0", direct.state()),
+        ("via t1", earlier.state()),
+    ] {
+        prop_assert_eq!(state.t, t0);
+        for (k, (a, b)) in state.q.iter().zip(expected.iter()).enumerate() {
+            let scale = match scene.coordinate_unit(k) {
+                Unit::Angle => 1.0,
+                _ => sampling.size,
+            };
+            prop_assert!(
+                (a - b).abs() <= 1e-8 * scale,
+                "{} t0 = {}, t1 = {}: q[{}] = {} vs {} stepped from 0",
+                how,
+                t0,
+                t1,
+                k,
+                a,
+                b
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Deterministic (fixed seed), and no regression file written into the tree.
+fn config() -> ProptestConfig {
+    ProptestConfig {
+        cases: 40,
+        failure_persistence: None,
+        rng_seed: RngSeed::Fixed(20),
+        ..ProptestConfig::default()
+    }
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn a_state_does_not_depend_on_the_start_time_or_the_times_asked_before(
+        scene in 0_usize..5,
+        u0 in 0.02_f64..1.0,
+        u1 in 0.0_f64..1.0,
+    ) {
+        let (four_bar, mirror, whitworth, peaucellier, seed) = (
+            Sampling { horizon: 3.0, rate: 200.0, size: 120.0 },
+            Sampling { horizon: 20.0, rate: 20.0, size: 50.0 },
+            Sampling { horizon: 10.0, rate: 40.0, size: 100.0 },
+            Sampling { horizon: 10.0, rate: 40.0, size: 2.5 },
+            Sampling { horizon: 0.2, rate: 6000.0, size: 160.0 },
+        );
+        match scene {
+            0 => same_state_however_reached(
+                FourBar::default(), &four_bar, u0 * four_bar.horizon, u1 * four_bar.horizon,
+            )?,
+            1 => same_state_however_reached(
+                MirrorAtStart::default(), &mirror, u0 * mirror.horizon, u1 * mirror.horizon,
+            )?,
+            2 => same_state_however_reached(
+                Whitworth::default(), &whitworth, u0 * whitworth.horizon, u1 * whitworth.horizon,
+            )?,
+            3 => same_state_however_reached(
+                Peaucellier::default(),
+                &peaucellier,
+                u0 * peaucellier.horizon,
+                u1 * peaucellier.horizon,
+            )?,
+            _ => same_state_however_reached(
+                PistonCrank::default(), &seed, u0 * seed.horizon, u1 * seed.horizon,
+            )?,
+        }
+    }
 }
