@@ -7,9 +7,7 @@
 
 use mechgen_examples::scenes::{FourBar, PistonCrank};
 use mechgen_runtime::nalgebra::DefaultAllocator;
-use mechgen_runtime::{
-    Mechanism, Simulation, SolveError, Solver, Storage, Structured, Unit, mechanism,
-};
+use mechgen_runtime::{Simulation, SolveError, Solver, Storage, Structured, Unit, mechanism};
 use proptest::prelude::*;
 use proptest::test_runner::{RngSeed, TestCaseError};
 
