@@ -111,16 +111,19 @@ const GEOMETRY_HINT: &str = "change the named parameter with `--set NAME=VALUE` 
 fn assembly_hint(error: &SolveError) -> &'static str {
     match error {
         SolveError::NoConvergence { .. } => {
-            "move the `near (x, y, angle)` guesses of the moving bodies closer to an assembled \
-             pose, or check the dimensions: the joints may not be able to close at all"
+            "no solution found from these guesses (the residual was still decreasing): move \
+             the `near (x, y, angle)` guesses of the bodies in the named equation's joint \
+             closer to an assembled pose"
         }
         SolveError::Singular { .. } => {
             "the named equation is redundant or conflicts with others at this pose: check the \
              joints, or move the `near` guesses away from a dead-centre position"
         }
         SolveError::NoAssembly { .. } => {
-            "the joints cannot all close with these dimensions: check the lengths, the \
-             parameters and the drivers' values at the start time"
+            "the residual above is a minimum no direction reduces (a guess with links in line \
+             is left along its free direction, so the guesses' shape is not the cause): the \
+             joints cannot all close with these dimensions; check the lengths, the parameters \
+             and the drivers' values at the start time"
         }
         SolveError::BranchFlip { .. } => {
             "the guesses lead to another assembly branch than the scene's `branch` declares: \
