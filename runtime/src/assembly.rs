@@ -62,10 +62,9 @@ where
     #[allow(clippy::result_large_err)]
     pub fn new(mut solver: Solver<M>, t0: f64) -> Result<Self, AssemblyError<M>> {
         let mut current = State::new(solver.mechanism());
-        solver.mechanism().initial_guess(&mut current.q);
         let direct = t0 == GUESS_TIME || !t0.is_finite() || !has_blocks(solver.mechanism());
         let start = if direct { t0 } else { GUESS_TIME };
-        match solver.solve_into(start, &mut current) {
+        match assemble(&mut solver, start, &mut current) {
             Ok(()) if direct => Ok(Self::from_state(solver, current)),
             Ok(()) => Self::from_state(solver, current).follow_to(t0),
             Err(error) => Err(AssemblyError { error, solver }),
@@ -133,6 +132,30 @@ where
         (state.substeps, state.iterations, state.evaluations) = (steps, iterations, evaluations);
         Ok(self)
     }
+}
+
+/// Solves from the declared guess at `t` into `state`. A guess with links in line is a
+/// stationary point that Newton leaves along the Jacobian's null direction, on one side first;
+/// when that side leads off a declared branch, the other side is tried (the branch the
+/// declarations choose). Otherwise the first solve's error stands.
+fn assemble<M: Structured>(
+    solver: &mut Solver<M>,
+    t: f64,
+    state: &mut State<M>,
+) -> Result<(), SolveError>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    solver.mechanism().initial_guess(&mut state.q);
+    let error = match solver.solve_into(t, state) {
+        Err(error @ SolveError::BranchFlip { .. }) => error,
+        solved => return solved,
+    };
+    solver.escape_side = -1.0;
+    solver.mechanism().initial_guess(&mut state.q);
+    let other = solver.solve_into(t, state);
+    solver.escape_side = 1.0;
+    other.map_err(|_| error)
 }
 
 /// Whether any stage of the scene is a Newton block (which may have several solutions).

@@ -126,6 +126,9 @@ pub enum SolveError {
         iterations: usize,
         /// ‖Φ‖∞ at the last iterate.
         residual: f64,
+        /// The equation with the largest scaled residual there: its joint's bodies are the
+        /// ones whose guesses to move.
+        equation: usize,
     },
     /// The constraints cannot all be satisfied: the least-squares residual stopped decreasing
     /// well above the tolerance (links too short to close, a driver beyond the reachable range,
@@ -302,11 +305,19 @@ impl SolveError {
                 time,
                 iterations,
                 residual,
-            } => write!(
-                f,
-                "no convergence at t = {time} after {iterations} Newton iterations \
-                 (‖Φ‖∞ = {residual:e}); try a smaller time step or a better initial guess"
-            ),
+                equation: index,
+            } => {
+                write!(
+                    f,
+                    "no convergence at t = {time} after {iterations} Newton iterations \
+                     (‖Φ‖∞ = {residual:e}, largest in equation "
+                )?;
+                equation(f, index)?;
+                f.write_str(
+                    "); not found from this guess: try a smaller time step, or move the \
+                     initial guesses of that equation's bodies closer to an assembled pose",
+                )
+            }
             Self::NoAssembly {
                 time,
                 iterations,
@@ -471,6 +482,7 @@ where
                 names.coordinate = m.coordinate_name(coordinate);
             }
             SolveError::NoAssembly { equation, .. }
+            | SolveError::NoConvergence { equation, .. }
             | SolveError::Unresolved { equation, .. }
             | SolveError::NonFinite {
                 equation: Some(equation),
@@ -585,6 +597,7 @@ mod tests {
                 time: 0.5,
                 iterations: 25,
                 residual: 1e-3,
+                equation: 0,
             },
         ];
         for error in errors {

@@ -109,6 +109,8 @@ pub(crate) struct Newton<'a, 'w, M> {
     /// the last one's.
     signs: (bool, bool),
     orientation: f64,
+    /// The side a stationary point is left by first ([`Newton::escape`]): +1 or −1.
+    pub escape_side: f64,
 }
 
 impl<'a, 'w, M: Structured> Newton<'a, 'w, M>
@@ -131,6 +133,7 @@ where
             evaluations: 0,
             signs: (false, false),
             orientation: 1.0,
+            escape_side: 1.0,
         }
     }
 
@@ -431,10 +434,12 @@ where
         if marquardt.used {
             self.no_assembly(q, iterations)
         } else {
+            let (equation, residual) = self.worst_equation();
             SolveError::NoConvergence {
                 time: self.t,
                 iterations,
-                residual: max_abs(&self.parts.newton.phi[..self.bs.n()]),
+                residual,
+                equation,
             }
         }
     }
@@ -676,8 +681,8 @@ where
     /// From a stationary point `q` (Φ_b in `phi`, scaled Jacobian S in `dense`) where the merit
     /// is `merit`: the direction v that S maps closest to zero (inverse iteration on
     /// SᵀS + μI, μ tiny against the largest squared column norm `largest`), signed so that its
-    /// largest component is positive, and steps of ±1/2ᵏ scene lengths or radians along it (+
-    /// first, longest first). Along v the residual changes only at second order, so a saddle
+    /// largest component is positive, and steps of ±1/2ᵏ scene lengths or radians along it
+    /// (the [`Newton::escape_side`] first, longest first). Along v the residual changes only at second order, so a saddle
     /// (a flat guess: every link on one line) is left by one of them; the first that reduces
     /// the merit is taken (its Φ_b in `phi`) and `true` returned. `false` (and `q` unchanged)
     /// when none does: a minimum, where the loop cannot close.
@@ -712,7 +717,7 @@ where
             v.iter_mut().for_each(|x| *x /= norm);
         }
         self.save_base(q);
-        for sign in [1.0, -1.0] {
+        for sign in [self.escape_side, -self.escape_side] {
             let mut length = self.options.max_step;
             for _ in 0..6 {
                 let parts = &mut *self.parts;

@@ -246,6 +246,10 @@ where
     /// How many dependent equations and undetermined coordinates the last diagnosis found
     /// (heads of the workspace's diagnosis buffers).
     diagnosed: (usize, usize),
+    /// Which side of a stationary guess Newton leaves it by first (+1 or −1; see the
+    /// `position` module's escape): [`crate::Simulation::new`] tries the other side when the
+    /// first leads off a declared branch.
+    pub(crate) escape_side: f64,
 }
 
 /// A copy with its own workspace (to run the same scene on another thread, or to restart
@@ -262,6 +266,7 @@ where
             workspace: self.workspace.clone(),
             length: self.length,
             diagnosed: self.diagnosed,
+            escape_side: self.escape_side,
         }
     }
 }
@@ -315,6 +320,7 @@ where
             options,
             length: LengthScale::new(1.0),
             diagnosed: (0, 0),
+            escape_side: 1.0,
         }
     }
 
@@ -487,6 +493,7 @@ where
             workspace,
             length,
             diagnosed,
+            escape_side,
         } = self;
         let mut parts = workspace.parts();
         let mut total = Convergence::start(options.estimate_condition);
@@ -504,6 +511,7 @@ where
                     let bs = BlockSolve { m, stage: s, block };
                     bs.set_scales(&mut parts.scales, length);
                     let mut newton = Newton::new(bs, &mut parts, options, t);
+                    newton.escape_side = *escape_side;
                     let solved = newton
                         .solve(q, rates != Rates::None)
                         .map_err(|e| record(e, m, s, newton.parts, diagnosed))?;
@@ -586,6 +594,7 @@ where
             workspace,
             length,
             diagnosed,
+            ..
         } = self;
         let mut parts = workspace.parts();
         for s in 0..m.stage_count() {
@@ -625,6 +634,7 @@ where
             workspace,
             length,
             diagnosed,
+            ..
         } = self;
         let mut parts = workspace.parts();
         let mut worst: Option<(usize, Block<'_>, f64)> = None;
