@@ -248,3 +248,77 @@ proptest! {
         }
     }
 }
+
+/// The issue's scene as `mechgen solve` reads it: the interpreter, the CLI's solver path.
+const MIRROR_AT_START: &str = "
+mechanism MirrorAtStart {
+    ground frame at (0, 0, 0);
+    body crank near (0, 0, 0);
+    body lever near (0, 0, 0);
+    joint crank_pivot: revolute(frame @ (0, 30), crank);
+    joint lever_pivot: revolute(frame, lever);
+    joint pin: slot(lever, crank @ (50, 0), along (1, 0));
+    driver spin: angle(crank) = t;
+}";
+
+#[test]
+fn a_start_at_three_seconds_is_not_the_mirror() {
+    // `--at 3` gave the mirror angle −0.6426; the motion from t = 0 reaches 2.4990.
+    let expected = lever_angle(3.0);
+    assert!((expected - 2.4990).abs() < 1e-4, "{expected}");
+    let scene = mechgen::compile_str(MIRROR_AT_START).unwrap();
+    let interpreted = mechgen_cli::Interpreted::new(&scene);
+    let simulation = Simulation::new(Solver::new(interpreted), 3.0).unwrap();
+    let theta = simulation.state().q[MirrorAtStart::LEVER_THETA];
+    assert!((theta - expected).abs() < 1e-10, "{theta}");
+    let generated = Simulation::new(Solver::new(MirrorAtStart::default()), 3.0).unwrap();
+    assert!((generated.state().q[MirrorAtStart::LEVER_THETA] - expected).abs() < 1e-10);
+}
+
+#[test]
+fn every_start_time_of_the_quick_return_gives_the_ram_the_motion_reaches() {
+    // The issue's count: 9 of 20 start times in 0..3 s gave the wrong ram position.
+    let mut reference = Simulation::new(Solver::new(Whitworth::default()), 0.0).unwrap();
+    for k in 1..=20 {
+        let t0 = 3.0 * k as f64 / 20.0;
+        // The motion from t = 0 in steps of 0.5 ms (1 mrad of crank).
+        reference.run(t0, 300, |_| {}).unwrap();
+        let expected = reference.state().q;
+        let started = Simulation::new(Solver::new(Whitworth::default()), t0).unwrap();
+        let q = &started.state().q;
+        assert!(
+            (q[Whitworth::RAM_X] - expected[Whitworth::RAM_X]).abs() < 1e-8 * 100.0,
+            "t0 = {t0}: ram at {} vs {}",
+            q[Whitworth::RAM_X],
+            expected[Whitworth::RAM_X]
+        );
+        assert!((q[Whitworth::LEVER_THETA] - expected[Whitworth::LEVER_THETA]).abs() < 1e-8);
+    }
+}
+
+#[test]
+fn a_start_time_beyond_the_step_budget_is_refused() {
+    // The seed at 314 rad/s from t = 0 to t0 = 1e4 s: 3.1e6 rad of crank, more than the
+    // budget's steps of about 0.2 scene lengths or radians can follow.
+    let failure = Simulation::new(Solver::new(PistonCrank::default()), 1e4)
+        .err()
+        .expect("out of reach");
+    let SolveError::Unreachable {
+        time,
+        reached,
+        steps,
+    } = failure.error
+    else {
+        panic!("{failure}");
+    };
+    assert_eq!(
+        (time, steps),
+        (1e4, mechgen_runtime::MAX_CONTINUATION_STEPS)
+    );
+    assert!(reached > 0.0 && reached < time, "{reached}");
+    let text = failure.to_string();
+    assert!(
+        text.contains("out of reach") && text.contains("t = 0"),
+        "{text}"
+    );
+}
