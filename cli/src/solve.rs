@@ -4,7 +4,9 @@
 use std::io::Write;
 
 use mechgen_runtime::nalgebra::DVector;
-use mechgen_runtime::{Mechanism, Simulation, SolveError, Solver, State, write_csv_header};
+use mechgen_runtime::{
+    GUESS_TIME, Mechanism, Simulation, SolveError, Solver, State, write_csv_header,
+};
 
 use crate::Interpreted;
 
@@ -127,10 +129,22 @@ pub fn assemble(
     t0: f64,
 ) -> Result<Simulation<Interpreted>, Box<Unassembled>> {
     Simulation::new(Solver::new(mechanism), t0).map_err(|failure| {
+        // Between t = 0 and t0 the failure is a step of the motion followed to the start.
+        let time = failure.error.time().unwrap_or(t0);
+        let (context, hint) = if time != t0 && time != GUESS_TIME {
+            (
+                format!(
+                    " at t0 = {t0} (the `near` guesses describe t = 0; following the motion \
+                     from there, it stopped at t = {time})"
+                ),
+                step_hint(&failure.error),
+            )
+        } else {
+            (String::new(), assembly_hint(&failure.error))
+        };
         let message = format!(
-            "cannot assemble `{}`: {failure}\n  hint: {}",
+            "cannot assemble `{}`{context}: {failure}\n  hint: {hint}",
             failure.solver.mechanism().name(),
-            assembly_hint(&failure.error)
         );
         Box::new(Unassembled {
             message,
@@ -170,16 +184,19 @@ const GEOMETRY_HINT: &str = "change the named parameter with `--set NAME=VALUE` 
 fn assembly_hint(error: &SolveError) -> &'static str {
     match error {
         SolveError::NoConvergence { .. } => {
-            "move the `near (x, y, angle)` guesses of the moving bodies closer to an assembled \
-             pose, or check the dimensions: the joints may not be able to close at all"
+            "no solution found from these guesses (the residual was still decreasing): move \
+             the `near (x, y, angle)` guesses of the bodies in the named equation's joint \
+             closer to an assembled pose"
         }
         SolveError::Singular { .. } => {
             "the named equation is redundant or conflicts with others at this pose: check the \
              joints, or move the `near` guesses away from a dead-centre position"
         }
         SolveError::NoAssembly { .. } => {
-            "the joints cannot all close with these dimensions: check the lengths, the \
-             parameters and the drivers' values at the start time"
+            "the residual above is a minimum no direction reduces (a guess with links in line \
+             is left along its free direction, so the guesses' shape is not the cause): the \
+             joints cannot all close with these dimensions; check the lengths, the parameters \
+             and the drivers' values at the start time"
         }
         SolveError::BranchFlip { .. } => {
             "the guesses lead to another assembly branch than the scene's `branch` declares: \
@@ -190,6 +207,10 @@ fn assembly_hint(error: &SolveError) -> &'static str {
              positions near the scene's size, and check parameters that set huge values"
         }
         SolveError::Geometry { .. } => GEOMETRY_HINT,
+        SolveError::Unreachable { .. } => {
+            "start the run nearer t = 0 (`--t0`), or write the drivers so that the motion of \
+             interest starts near t = 0"
+        }
         _ => "check the parameter values and the `near` guesses for divisions by zero",
     }
 }

@@ -4,7 +4,12 @@
 //! only ~1/√ε, and a step can land on either side of a toggle. Neither the condition limit nor
 //! the crawl test can then be relied on. The determinant's sign can be: the LU factors of every
 //! solve give it for free ([`crate::State::orientation`]), and it can change between two
-//! solutions only if Φ_q is singular somewhere in between. When a step ends with the other
+//! solutions only if Φ_q is singular somewhere in between. It is tracked per block
+//! ([`crate::Convergence::block_signs`]): the product of the blocks' signs would hide two
+//! blocks that flip in the same step (two levers on one pin, each its own block). Within one
+//! block an even number of flips (two loops of one block through their toggles in the same
+//! step) keeps the block's sign and is not seen here; the jump test of stepping (the solution
+//! far from the prediction) and declared branch invariants are what catch that case. When a step ends with the other
 //! sign, the step's time interval is bisected. Each midpoint is solved from the latest solution
 //! on the starting side, which keeps the starting branch, until no double lies between the two
 //! ends. The result is either the crossing, located to the last bit of the time and reported as
@@ -47,7 +52,7 @@ where
     /// is left in the scratch state for the caller to accept.
     pub(crate) fn locate_crossing(&mut self, t_end: f64) -> Result<(), SolveError> {
         let (current, _) = pair(&mut self.states, self.newest);
-        let sign = current.orientation;
+        let signs = current.block_signs;
         self.bracket.copy_from(current);
         let (mut low, mut high) = (current.t, t_end);
         let mut flip = None;
@@ -56,7 +61,7 @@ where
             if middle == low || middle == high {
                 break;
             }
-            match self.side(middle, sign)? {
+            match self.side(middle, signs)? {
                 Side::Start => low = middle,
                 Side::Other(error) => (high, flip) = (middle, error.or(flip)),
             }
@@ -64,7 +69,7 @@ where
         // Every midpoint stayed on the starting side: the step's end may have been a jump to
         // the mirror branch rather than a crossing. Solve it from the bracket to find out.
         if high == t_end {
-            match self.side(t_end, sign)? {
+            match self.side(t_end, signs)? {
                 Side::Start => return Ok(()),
                 Side::Other(error) => flip = error.or(flip),
             }
@@ -84,9 +89,9 @@ where
     /// A `Singular` solve (the solver's own diagnosis of the configuration it reached), or,
     /// for any other failure next to the crossing (no convergence, no assembly: the
     /// configuration locks up there), the diagnosis at the bracket.
-    fn side(&mut self, t: f64, sign: i8) -> Result<Side, SolveError> {
+    fn side(&mut self, t: f64, signs: u64) -> Result<Side, SolveError> {
         match self.solve_from_bracket(t) {
-            Ok((orientation, false)) if orientation == sign => {
+            Ok((reached, false)) if reached == signs => {
                 let (_, next) = pair(&mut self.states, self.newest);
                 self.bracket.copy_from(next);
                 Ok(Side::Start)
@@ -99,15 +104,43 @@ where
     }
 
     /// Solves at `t` from the bracket (Taylor prediction, no history) into the scratch state,
-    /// returning the solution's determinant sign and whether Newton crossed a singular
+    /// returning the solution's block determinant signs and whether Newton crossed a singular
     /// configuration to get there.
-    fn solve_from_bracket(&mut self, t: f64) -> Result<(i8, bool), SolveError> {
+    fn solve_from_bracket(&mut self, t: f64) -> Result<(u64, bool), SolveError> {
         let (_, next) = pair(&mut self.states, self.newest);
         if !predict(&self.bracket, next, false, t) {
             next.q.copy_from(&self.bracket.q);
         }
         self.has_previous = false;
         self.solver.solve_into(t, next)?;
-        Ok((next.orientation, next.swept))
+        Ok((next.block_signs, next.swept))
+    }
+}
+
+/// The code of stage `stage` in [`crate::Convergence::block_signs`]: the splitmix64 finaliser
+/// of the index, a bijection of `u64`, so that distinct stages get distinct codes and the
+/// signatures of two sets of blocks that differ in one or two blocks always differ. Zero only
+/// for one index far beyond any scene (checked below for the first 2²⁰ stages).
+pub(crate) fn block_code(stage: usize) -> u64 {
+    let mut z = (stage as u64).wrapping_add(0x9E37_79B9_7F4A_7C15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::block_code;
+
+    #[test]
+    fn block_codes_are_non_zero_and_no_two_cancel() {
+        // XOR of two codes is zero only for equal codes: a bijection makes them distinct.
+        let mut seen = [0_u64; 1 << 12];
+        for (stage, code) in seen.iter_mut().enumerate() {
+            *code = block_code(stage);
+        }
+        seen.sort_unstable();
+        assert!(seen.windows(2).all(|w| w[0] != w[1]));
+        assert!((0..1 << 20).all(|stage| block_code(stage) != 0));
     }
 }

@@ -126,6 +126,9 @@ pub enum SolveError {
         iterations: usize,
         /// ‖Φ‖∞ at the last iterate.
         residual: f64,
+        /// The equation with the largest scaled residual there: its joint's bodies are the
+        /// ones whose guesses to move.
+        equation: usize,
     },
     /// The constraints cannot all be satisfied: the least-squares residual stopped decreasing
     /// well above the tolerance (links too short to close, a driver beyond the reachable range,
@@ -209,6 +212,18 @@ pub enum SolveError {
         /// What it must be.
         requirement: Requirement,
     },
+    /// [`crate::Simulation::new`] followed the motion from t = 0 (where the `near` guesses
+    /// describe the mechanism) towards the start time for
+    /// [`crate::MAX_CONTINUATION_STEPS`] steps without reaching it: the state there
+    /// cannot be shown to be the one continuous motion reaches.
+    Unreachable {
+        /// The start time asked for.
+        time: f64,
+        /// The time the motion was followed to.
+        reached: f64,
+        /// Steps taken.
+        steps: usize,
+    },
     /// A vector passed in does not have `dim()` entries (only possible with `Dyn` mechanisms).
     DimensionMismatch {
         /// The mechanism's `dim()`.
@@ -251,7 +266,8 @@ impl SolveError {
             | Self::Singular { time, .. }
             | Self::BranchFlip { time, .. }
             | Self::NonFinite { time, .. }
-            | Self::Geometry { time, .. } => Some(time),
+            | Self::Geometry { time, .. }
+            | Self::Unreachable { time, .. } => Some(time),
             Self::DimensionMismatch { .. } => None,
         }
     }
@@ -289,11 +305,19 @@ impl SolveError {
                 time,
                 iterations,
                 residual,
-            } => write!(
-                f,
-                "no convergence at t = {time} after {iterations} Newton iterations \
-                 (‖Φ‖∞ = {residual:e}); try a smaller time step or a better initial guess"
-            ),
+                equation: index,
+            } => {
+                write!(
+                    f,
+                    "no convergence at t = {time} after {iterations} Newton iterations \
+                     (‖Φ‖∞ = {residual:e}, largest in equation "
+                )?;
+                equation(f, index)?;
+                f.write_str(
+                    "); not found from this guess: try a smaller time step, or move the \
+                     initial guesses of that equation's bodies closer to an assembled pose",
+                )
+            }
             Self::NoAssembly {
                 time,
                 iterations,
@@ -403,6 +427,16 @@ impl SolveError {
                     requirement.describe()
                 )
             }
+            Self::Unreachable {
+                time,
+                reached,
+                steps,
+            } => write!(
+                f,
+                "the start time t = {time} is out of reach: the `near` guesses describe the \
+                 mechanism at t = 0, and {steps} steps of its motion from there reached only \
+                 t = {reached}; start nearer t = 0"
+            ),
             Self::DimensionMismatch { expected, found } => {
                 write!(
                     f,
@@ -448,6 +482,7 @@ where
                 names.coordinate = m.coordinate_name(coordinate);
             }
             SolveError::NoAssembly { equation, .. }
+            | SolveError::NoConvergence { equation, .. }
             | SolveError::Unresolved { equation, .. }
             | SolveError::NonFinite {
                 equation: Some(equation),
@@ -562,6 +597,7 @@ mod tests {
                 time: 0.5,
                 iterations: 25,
                 residual: 1e-3,
+                equation: 0,
             },
         ];
         for error in errors {

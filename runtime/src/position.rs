@@ -71,6 +71,8 @@ struct Marquardt {
     stalls: usize,
     /// Whether any step was needed: a capped solve that needed them did not assemble.
     used: bool,
+    /// Whether a step along the Jacobian's null direction was tried ([`Newton::escape`]).
+    escaped: bool,
 }
 
 /// A block solved at one time.
@@ -107,6 +109,8 @@ pub(crate) struct Newton<'a, 'w, M> {
     /// the last one's.
     signs: (bool, bool),
     orientation: f64,
+    /// The side a stationary point is left by first ([`Newton::escape`]): +1 or −1.
+    pub escape_side: f64,
 }
 
 impl<'a, 'w, M: Structured> Newton<'a, 'w, M>
@@ -129,6 +133,7 @@ where
             evaluations: 0,
             signs: (false, false),
             orientation: 1.0,
+            escape_side: 1.0,
         }
     }
 
@@ -429,10 +434,12 @@ where
         if marquardt.used {
             self.no_assembly(q, iterations)
         } else {
+            let (equation, residual) = self.worst_equation();
             SolveError::NoConvergence {
                 time: self.t,
                 iterations,
-                residual: max_abs(&self.parts.newton.phi[..self.bs.n()]),
+                residual,
+                equation,
             }
         }
     }
@@ -658,7 +665,92 @@ where
             self.restore(q);
             marquardt.mu = mu * 4.0;
         }
+        // No damped step reduces the residual: a stationary point. At a singular start (links
+        // guessed in line) that is a saddle, left along the Jacobian's null direction; at a
+        // minimum of the residual no direction reduces it, and the loop cannot close.
+        if !marquardt.escaped {
+            marquardt.escaped = true;
+            if self.escape(q, merit, largest)? {
+                *iterations += 1;
+                return Ok(());
+            }
+        }
         Err(self.no_assembly(q, *iterations))
+    }
+
+    /// From a stationary point `q` (Φ_b in `phi`, scaled Jacobian S in `dense`) where the merit
+    /// is `merit`: the direction v that S maps closest to zero (inverse iteration on
+    /// SᵀS + μI, μ tiny against the largest squared column norm `largest`), signed so that its
+    /// largest component is positive, and steps of ±1/2ᵏ scene lengths or radians along it
+    /// (the [`Newton::escape_side`] first, longest first). Along v the residual changes only at second order, so a saddle
+    /// (a flat guess: every link on one line) is left by one of them; the first that reduces
+    /// the merit is taken (its Φ_b in `phi`) and `true` returned. `false` (and `q` unchanged)
+    /// when none does: a minimum, where the loop cannot close.
+    fn escape(
+        &mut self,
+        q: &mut Vector<M::Dim>,
+        merit: f64,
+        largest: f64,
+    ) -> Result<bool, SolveError> {
+        let n = self.bs.n();
+        let parts = &mut *self.parts;
+        let (lu, swaps) = (
+            &mut parts.factors.lu[..n * n],
+            &mut parts.factors.swaps[..n],
+        );
+        normal_matrix(&parts.dense[..n * n], n, 1e-10 * largest, lu);
+        if lu::factor_in_place(lu, swaps, 0.0, 0.0).is_err() {
+            return Ok(false);
+        }
+        let v = &mut parts.newton.step[..n];
+        v.fill(1.0);
+        for _ in 0..3 {
+            lu::solve_factors(lu, swaps, v);
+            let size = max_abs(v);
+            if !(size.is_finite() && size > 0.0) {
+                return Ok(false);
+            }
+            let sign = v
+                .iter()
+                .fold(0.0_f64, |m, x| if x.abs() > m.abs() { *x } else { m });
+            let norm = size.copysign(sign);
+            v.iter_mut().for_each(|x| *x /= norm);
+        }
+        self.save_base(q);
+        for sign in [self.escape_side, -self.escape_side] {
+            let mut length = self.options.max_step;
+            for _ in 0..6 {
+                let parts = &mut *self.parts;
+                let qs = q.as_mut_slice();
+                for (((&b, &v), &c), &j) in parts
+                    .newton
+                    .base
+                    .iter()
+                    .zip(parts.newton.step.iter())
+                    .zip(parts.scales.cols.iter())
+                    .zip(self.bs.block.coordinates)
+                {
+                    qs[j] = b + sign * length * v * c;
+                }
+                self.bs.m.block_jacobian(
+                    self.bs.stage,
+                    q,
+                    parts.trig,
+                    self.t,
+                    &mut parts.newton.trial[..n],
+                    &mut parts.factors.values[..self.bs.block.slots],
+                );
+                let trial = scaled_norms(&parts.newton.trial[..n], parts.scales.rows).0;
+                if trial < (1.0 - SUFFICIENT_DECREASE) * merit {
+                    let newton = &mut self.parts.newton;
+                    newton.phi[..n].copy_from_slice(&newton.trial[..n]);
+                    return Ok(true);
+                }
+                length *= 0.5;
+            }
+        }
+        self.restore(q);
+        Ok(false)
     }
 
     /// Φ_b at `q` into `phi` (the Jacobian values are overwritten and not used).

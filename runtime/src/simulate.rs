@@ -21,6 +21,13 @@ const JUMP_FRACTION: f64 = 0.5;
 /// that a mechanism at rest, whose predicted motion is zero, is not suspect for the corrections
 /// of round-off or of a loosely converged solve.
 const JUMP_FLOOR: f64 = 1e-6;
+/// A predicted step is also suspect when the prediction moves a block coordinate by more than
+/// this (scaled: scene lengths, radians), however close Newton lands to it: over so long a
+/// step the Taylor prediction says nothing about which turn of a lever or which side of a
+/// crank the motion reaches, so a solution near it may be another winding of the same pose
+/// (a single step of 20 rad of crank gave a lever four turns ahead). It is the solver's
+/// default step clamp: no single Newton step moves further either.
+const MAX_PREDICTED_MOTION: f64 = 1.0;
 /// Default number of times a failed step may be halved; see [`Simulation::set_max_halvings`].
 pub const DEFAULT_MAX_HALVINGS: u32 = 10;
 
@@ -173,7 +180,9 @@ where
     /// updates, the second of round-off size (whose factors then serve the rates).
     ///
     /// When that solve fails in a way a shorter step may cure (no convergence, no assembly, a
-    /// branch flip) or lands suspiciously far from the prediction (the mirror branch), the
+    /// branch flip, a singular solution), predicts a motion of more than a scene length or a
+    /// radian of a block's coordinates, or lands suspiciously far from the prediction (the
+    /// mirror branch), the
     /// drivers are sub-stepped: the interval is halved, and halved again on failure, down to
     /// 2^-`max_halvings` of it, each sub-step predicted from the last. The state then records the
     /// sub-steps taken ([`State::substeps`]) and all their Newton iterations, evaluations and
@@ -188,7 +197,7 @@ where
         }
         match self.advance(t, false) {
             Outcome::Solved => {}
-            Outcome::Failed(error) if !error.is_step_related() || self.max_halvings == 0 => {
+            Outcome::Failed(error) if !retryable(&error) || self.max_halvings == 0 => {
                 return Err(error);
             }
             Outcome::Jumped if self.max_halvings == 0 => self.accept(),
@@ -264,7 +273,7 @@ where
                         (h, successes) = (2.0 * h, 0);
                     }
                 }
-                Outcome::Failed(error) if !error.is_step_related() || finest => {
+                Outcome::Failed(error) if !retryable(&error) || finest => {
                     self.states[self.newest].copy_from(&self.saved);
                     return Err(error);
                 }
@@ -296,11 +305,11 @@ where
                     .block_distances(&current.q, &self.prediction, &next.q);
             let options = self.solver.options();
             let floor = JUMP_FLOOR + 10.0 * (options.residual_tolerance + options.step_tolerance);
-            if correction > JUMP_FRACTION * motion + floor {
+            if correction > JUMP_FRACTION * motion + floor || motion > MAX_PREDICTED_MOTION {
                 return Outcome::Jumped;
             }
         }
-        if next.orientation != current.orientation || next.swept {
+        if next.block_signs != current.block_signs || next.swept {
             return Outcome::Crossed;
         }
         self.accept();
@@ -332,6 +341,15 @@ where
         }
         Ok(())
     }
+}
+
+/// Whether a failed solve is retried in shorter sub-steps: the failures a shorter step may cure
+/// ([`SolveError::is_step_related`]), and a singular solution, which Newton may have reached
+/// from a prediction off the motion (a Peaucellier cell's two circles made to coincide by a
+/// long step); a toggle on the motion stays singular down to the finest sub-step, which then
+/// reports it at its time.
+fn retryable(error: &SolveError) -> bool {
+    error.is_step_related() || matches!(error, SolveError::Singular { .. })
 }
 
 /// The state at `newest` and the other one.

@@ -153,6 +153,12 @@ pub struct Convergence {
     /// coefficients). It changes between two solutions only if Φ_q is singular somewhere
     /// between them; [`crate::Simulation`] watches it to catch toggle crossings.
     pub orientation: i8,
+    /// Which blocks have a negative determinant: the XOR of a 64-bit code per such block
+    /// ([`crate::crossing::block_code`], distinct and non-zero for every stage). Two states
+    /// whose blocks' signs differ have a singular configuration between them even when an even
+    /// number of blocks flipped and `orientation` did not change; the codes of two different
+    /// blocks never cancel (three or more could, with a chance of order 2⁻⁶⁴).
+    pub block_signs: u64,
     /// Whether a block's Newton iterates met both determinant signs: the iteration crossed
     /// a singular configuration between its start and the solution.
     pub swept: bool,
@@ -167,11 +173,12 @@ impl Convergence {
             fallbacks: 0,
             evaluations: 0,
             orientation: 1,
+            block_signs: 0,
             swept: false,
         }
     }
 
-    fn add(&mut self, block: &Solved, newton: (usize, usize)) {
+    fn add(&mut self, stage: usize, block: &Solved, newton: (usize, usize)) {
         let (fallbacks, evaluations) = newton;
         self.iterations = self.iterations.max(block.iterations);
         self.residual = self.residual.max(block.residual);
@@ -185,6 +192,7 @@ impl Convergence {
         self.evaluations += evaluations;
         if block.orientation < 0.0 {
             self.orientation = -self.orientation;
+            self.block_signs ^= crate::crossing::block_code(stage);
         }
         self.swept |= block.swept;
     }
@@ -238,6 +246,10 @@ where
     /// How many dependent equations and undetermined coordinates the last diagnosis found
     /// (heads of the workspace's diagnosis buffers).
     diagnosed: (usize, usize),
+    /// Which side of a stationary guess Newton leaves it by first (+1 or −1; see the
+    /// `position` module's escape): [`crate::Simulation::new`] tries the other side when the
+    /// first leads off a declared branch.
+    pub(crate) escape_side: f64,
 }
 
 /// A copy with its own workspace (to run the same scene on another thread, or to restart
@@ -254,6 +266,7 @@ where
             workspace: self.workspace.clone(),
             length: self.length,
             diagnosed: self.diagnosed,
+            escape_side: self.escape_side,
         }
     }
 }
@@ -307,6 +320,7 @@ where
             options,
             length: LengthScale::new(1.0),
             diagnosed: (0, 0),
+            escape_side: 1.0,
         }
     }
 
@@ -411,6 +425,7 @@ where
         state.evaluations = convergence.evaluations;
         state.fallbacks = convergence.fallbacks;
         state.orientation = convergence.orientation;
+        state.block_signs = convergence.block_signs;
         state.swept = convergence.swept;
         Ok(())
     }
@@ -478,6 +493,7 @@ where
             workspace,
             length,
             diagnosed,
+            escape_side,
         } = self;
         let mut parts = workspace.parts();
         let mut total = Convergence::start(options.estimate_condition);
@@ -495,10 +511,11 @@ where
                     let bs = BlockSolve { m, stage: s, block };
                     bs.set_scales(&mut parts.scales, length);
                     let mut newton = Newton::new(bs, &mut parts, options, t);
+                    newton.escape_side = *escape_side;
                     let solved = newton
                         .solve(q, rates != Rates::None)
                         .map_err(|e| record(e, m, s, newton.parts, diagnosed))?;
-                    total.add(&solved, (newton.fallbacks, newton.evaluations));
+                    total.add(s, &solved, (newton.fallbacks, newton.evaluations));
                     m.fill_trig(s, q, newton.parts.trig);
                     block_rates(
                         &newton.bs,
@@ -577,6 +594,7 @@ where
             workspace,
             length,
             diagnosed,
+            ..
         } = self;
         let mut parts = workspace.parts();
         for s in 0..m.stage_count() {
@@ -616,6 +634,7 @@ where
             workspace,
             length,
             diagnosed,
+            ..
         } = self;
         let mut parts = workspace.parts();
         let mut worst: Option<(usize, Block<'_>, f64)> = None;

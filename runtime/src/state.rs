@@ -83,6 +83,10 @@ where
     /// states of one motion with different signs have a singular configuration (a toggle or
     /// change point) between them ([`crate::Convergence::orientation`]).
     pub orientation: i8,
+    /// Which blocks have a negative determinant, as a signature
+    /// ([`crate::Convergence::block_signs`]): a step that flips two blocks keeps
+    /// `orientation` but changes this.
+    pub(crate) block_signs: u64,
     /// Whether the solve's Newton iterates crossed a singular configuration
     /// ([`crate::Convergence::swept`]).
     pub(crate) swept: bool,
@@ -178,6 +182,7 @@ where
             evaluations: 0,
             fallbacks: 0,
             orientation: 1,
+            block_signs: 0,
             swept: false,
             outputs: mechanism.outputs(),
             mechanism: PhantomData,
@@ -201,6 +206,7 @@ where
         self.evaluations = other.evaluations;
         self.fallbacks = other.fallbacks;
         self.orientation = other.orientation;
+        self.block_signs = other.block_signs;
         self.swept = other.swept;
     }
 
@@ -386,6 +392,7 @@ where
             evaluations: self.evaluations,
             fallbacks: self.fallbacks,
             orientation: self.orientation,
+            block_signs: self.block_signs,
             swept: self.swept,
             outputs: self.outputs,
             mechanism: PhantomData,
