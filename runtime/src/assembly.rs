@@ -48,7 +48,9 @@ where
     /// followed to `t0` with every stepping safeguard, in steps that move the blocks'
     /// coordinates about 0.2 scene lengths or radians, at most [`MAX_CONTINUATION_STEPS`] of
     /// them. The state then counts the continuation's steps in [`State::substeps`], and its
-    /// work in [`State::iterations`] and [`State::evaluations`].
+    /// work in [`State::iterations`] and [`State::evaluations`]. A guess with links in line
+    /// (a stationary point of the residual) is left on the side that gives the declared
+    /// branches, if either does.
     ///
     /// # Errors
     /// An [`AssemblyError`]: the [`SolveError`] of the assembly at t = 0 (the guesses describe

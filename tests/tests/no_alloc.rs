@@ -1,6 +1,7 @@
 //! Generated code through the runtime allocates nothing: positions, velocities and
 //! accelerations of the seed over many steps, the force solve (reactions and driver efforts),
-//! sub-stepping, every error path with its description, and CSV output.
+//! sub-stepping, assembly at a later start time (the motion followed from t = 0), every error
+//! path with its description, and CSV output.
 //!
 //! A counting global allocator wraps the system one. This file holds a single test so that no
 //! other test thread allocates while it counts.
@@ -99,6 +100,9 @@ fn generated_scenes_solve_without_allocating() {
 
     let mut four_bar = Simulation::new(Solver::new(FourBar::default()), 0.0).expect("four-bar");
     four_bar.run(1.0, 1_000, |_| {}).expect("four-bar solves");
+    // A start at t0 > 0: assembled at t = 0 and followed to t0.
+    let later = Simulation::new(Solver::new(FourBar::default()), 0.3).expect("four-bar at 0.3");
+    assert!(later.state().substeps > 1);
 
     // The force solve: reactions and efforts at every step, by name and as CSV columns.
     let mut dynamics =
