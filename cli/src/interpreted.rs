@@ -18,7 +18,7 @@ use mechgen::reactions::ForceStage;
 use mechgen::structure::{self, Phase, Plan};
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{
-    Accelerations, Block, Forces, GeometryFault, Matrix, Mechanism, Outputs, ParameterError,
+    Accelerations, Block, Forces, GeometryFault, Matrix, Mechanism, Names, Outputs, ParameterError,
     Pattern, Requirement, Stage, Structured, Unit, VecBuffers, Vector, Velocities,
 };
 
@@ -56,6 +56,8 @@ pub struct Interpreted {
     geometry: Vec<geometry::Check>,
     geometry_values: Tape,
     branch_names: Vec<String>,
+    /// Every name, `'static` for the errors the solver returns (interned, see `names`).
+    names: &'static Names,
     /// One tape per branch invariant (its signed value), and the same reading the trig cache.
     branches: Vec<Tape>,
     cached_branches: Vec<Tape>,
@@ -348,6 +350,15 @@ impl Interpreted {
             geometry: kin.geometry.clone(),
             geometry_values,
             branch_names: model.branches.iter().map(|b| b.name.clone()).collect(),
+            names: crate::names::intern([
+                vec![model.name.to_string()],
+                model.coordinate_names(),
+                model.equation_names(),
+                model.params.iter().map(|p| p.name.to_string()).collect(),
+                model.branches.iter().map(|b| b.name.clone()).collect(),
+                model.marker_names(),
+                model.loads.iter().map(|l| l.name.clone()).collect(),
+            ]),
             branches,
             cached_branches,
             stages,
@@ -467,6 +478,10 @@ impl Mechanism for Interpreted {
 
     fn dim(&self) -> Dyn {
         Dyn(self.coordinates.len())
+    }
+
+    fn names(&self) -> &'static Names {
+        self.names
     }
 
     fn coordinate_name(&self, index: usize) -> Option<&str> {

@@ -116,6 +116,9 @@ where
     fn marker_name(&self, index: usize) -> Option<&str> {
         self.inner.marker_name(index)
     }
+    fn names(&self) -> &'static crate::Names {
+        self.inner.names()
+    }
     fn coordinate_name(&self, index: usize) -> Option<&str> {
         self.inner.coordinate_name(index)
     }

@@ -18,6 +18,7 @@ use nalgebra::DefaultAllocator;
 use crate::block::{BlockSolve, Factors};
 use crate::error::{Quantity, SolveError};
 use crate::mechanism::{LengthScale, Storage, Vector};
+use crate::names::Names;
 use crate::position::Newton;
 use crate::solver::{SolverOptions, all_finite, check_finite, non_finite};
 use crate::structure::{Stage, Structured};
@@ -216,6 +217,7 @@ where
         time: t,
         quantity: Quantity::Reaction,
         equation: first,
+        names: &Names::NONE,
     }
 }
 

@@ -4,6 +4,7 @@ use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector};
 
 use crate::geometry::GeometryFault;
+use crate::names::Names;
 
 /// A column of coordinates or equation values (`Const<N>` for generated scenes: on the stack).
 pub type Vector<D> = OVector<f64, D>;
@@ -200,6 +201,14 @@ where
 
     /// The number of coordinates (= number of equations), as a value of the type-level dimension.
     fn dim(&self) -> Self::Dim;
+
+    /// The scene's name tables, which the solver attaches to every [`crate::SolveError`] it
+    /// returns so that the error names what failed. The default, [`Names::NONE`], leaves
+    /// errors with indices (the names methods below still serve
+    /// [`crate::SolveError::describe`]).
+    fn names(&self) -> &'static Names {
+        &Names::NONE
+    }
 
     /// Name of coordinate `index`, such as `"piston.x"`; `None` past the end.
     fn coordinate_name(&self, index: usize) -> Option<&str>;

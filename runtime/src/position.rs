@@ -27,6 +27,7 @@ use crate::block::{BlockSolve, Factors};
 use crate::error::{Quantity, SolveError};
 use crate::lu::{self, LuError};
 use crate::mechanism::{Storage, Vector};
+use crate::names::Names;
 use crate::solver::{SolverOptions, all_finite, non_finite};
 use crate::structure::Structured;
 use crate::workspace::Parts;
@@ -297,6 +298,7 @@ where
             time: self.t,
             quantity: Quantity::Phi,
             equation: row.and_then(|i| self.bs.block.equations.get(i).copied()),
+            names: &Names::NONE,
         })
     }
 
@@ -313,6 +315,7 @@ where
                 parts.newton.trial,
                 parts.factors.values,
             ),
+            names: &Names::NONE,
         }
     }
 
@@ -433,6 +436,7 @@ where
                 time: self.t,
                 iterations,
                 residual: max_abs(&self.parts.newton.phi[..self.bs.n()]),
+                names: &Names::NONE,
             }
         }
     }
@@ -456,6 +460,7 @@ where
             iterations,
             residual,
             equation,
+            names: &Names::NONE,
         }
     }
 
@@ -468,6 +473,7 @@ where
             iterations,
             residual,
             equation,
+            names: &Names::NONE,
         }
     }
 
@@ -518,6 +524,7 @@ where
                         coordinate: parts.col_order[0],
                         condition,
                         deficiency,
+                        names: &Names::NONE,
                     };
                 }
                 Err(_) => return self.non_finite_jacobian(q),
@@ -529,6 +536,7 @@ where
             coordinate: self.bs.block.coordinates.first().copied().unwrap_or(0),
             condition,
             deficiency: 0,
+            names: &Names::NONE,
         }
     }
 
