@@ -258,6 +258,47 @@ mechanism Broken {
     let _ = std::fs::remove_file(&path);
 }
 
+/// The four-bar with one joint too many: `check` points at that joint, line and column.
+#[test]
+fn check_points_at_the_joint_that_over_constrains() {
+    let four_bar = std::fs::read_to_string(scene("four_bar.mech")).expect("four-bar");
+    let cases = [
+        (
+            "joint extra: distance(frame @ (80, 0), rocker @ (50, 0), 50);",
+            "joint `extra` over-constrains it",
+            "remove joint `extra`, or remove 1 driver, such as `crank_angle`",
+        ),
+        (
+            "joint extra: revolute(rocker, frame @ (100, 0));",
+            "joints `rocker_pivot`, `extra` over-determine body `rocker`",
+            "remove joint `extra` (or `rocker_pivot`)",
+        ),
+    ];
+    for (k, (joint, what, fix)) in cases.into_iter().enumerate() {
+        let path = scratch(&format!("over_constrained_{k}.mech"));
+        let source = four_bar.replace(
+            "    driver crank_angle",
+            &format!("    {joint}\n    driver crank_angle"),
+        );
+        std::fs::write(&path, &source).expect("scene written");
+        let name = path.to_str().expect("UTF-8 path");
+        let out = mechgen(&["check", name]);
+        assert_eq!(out.status.code(), Some(1));
+        let errors = text(&out.stderr);
+        let line = source
+            .lines()
+            .position(|l| l.contains("joint extra"))
+            .unwrap()
+            + 1;
+        assert!(
+            errors.contains(&format!("{name}:{line}:11: error: ")),
+            "{errors}"
+        );
+        assert!(errors.contains(what) && errors.contains(fix), "{errors}");
+        let _ = std::fs::remove_file(&path);
+    }
+}
+
 #[test]
 fn unreadable_files_say_so() {
     let out = mechgen(&["check", "no/such/scene.mech"]);

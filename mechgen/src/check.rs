@@ -8,6 +8,7 @@
 mod dynamics;
 mod functions;
 mod library;
+mod redundancy;
 
 use std::collections::HashMap;
 
@@ -142,8 +143,9 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
         outputs,
     };
     if count {
-        let structure = Structure::of_model(&mut model);
-        cx.check_mobility(spec, &model, &structure);
+        let rows = Structure::rows_of(&mut model);
+        let structure = Structure::of_pattern(&rows, model.dim());
+        cx.check_mobility(spec, &model, &structure, &rows);
     }
     cx.lengths.check(&mut cx.errors);
     cx.errors.finish()?;
@@ -391,7 +393,13 @@ impl Checker {
     /// exactly the rest so that the system is square. A square system must then also be
     /// structurally non-singular ([`Structure`]): no group of constraints may over-determine
     /// some bodies while others keep free coordinates.
-    fn check_mobility(&mut self, spec: &Spec, model: &Model, structure: &Structure) {
+    fn check_mobility(
+        &mut self,
+        spec: &Spec,
+        model: &Model,
+        structure: &Structure,
+        rows: &[Vec<usize>],
+    ) {
         if self.check_floating(spec) {
             // A count would only blame the drivers for a body nothing holds.
             return;
@@ -410,6 +418,20 @@ impl Checker {
                 dof.to_string()
             },
         );
+        // The joints (and drivers) whose equations the others already impose, last declared
+        // first: the likeliest to have been added by mistake.
+        // A pin repeating an earlier one comes first, alone (its equations are the other's).
+        let over = structure.over_constraints(model);
+        let mut removable = redundancy::removable(model, rows, structure.rank, &over);
+        removable.reverse();
+        if let Some(&(later, earlier)) = redundancy::repeated_pins(model, &over).last() {
+            removable = vec![later, earlier];
+        }
+        let ground = model.bodies.iter().filter(|b| b.ground).count();
+        let joints: Vec<&Ident> = removable
+            .iter()
+            .filter_map(|&k| spec.joints.get(k.checked_sub(ground)?).map(|j| &j.name))
+            .collect();
         if dof < 0 {
             let part = if structure.over_equations.is_empty() {
                 String::new()
@@ -421,13 +443,30 @@ impl Checker {
                     structure.over_count(),
                 )
             };
-            self.errors.push(
-                spec.name.span(),
-                format!(
-                    "the joints over-constrain the mechanism ({count}){part}; remove joints or \
-                     add bodies"
+            // No joint whose equations are all redundant (without drivers, removing any
+            // joint frees a coordinate): the error goes to the last joint of the part.
+            let last = over
+                .iter()
+                .rev()
+                .find_map(|&k| spec.joints.get(k.checked_sub(ground)?));
+            let (span, fix) = match (joints.split_first(), last) {
+                (Some((first, others)), _) => (
+                    first.span(),
+                    format!(
+                        "{}: the other constraints already impose its equations",
+                        remove_joint(first, others)
+                    ),
                 ),
+                (None, Some(last)) => (last.name.span(), "remove joints or add bodies".to_owned()),
+                (None, None) => (spec.name.span(), "remove joints or add bodies".to_owned()),
+            };
+            self.errors.push(
+                span,
+                format!("the joints over-constrain the mechanism ({count}){part}; {fix}"),
             );
+        } else if dof == 0 && drivers > 0 && !joints.is_empty() {
+            // Drivers on a mechanism its joints hold rigid: a joint closed a loop twice.
+            self.joint_takes_drivers_freedom(spec, &joints, dof, &count);
         } else if drivers < dof {
             let missing = dof - drivers;
             let example = spec
@@ -518,6 +557,44 @@ impl Checker {
                 self.errors.push(span, &message);
             }
         }
+    }
+
+    /// Drivers on a mechanism its joints hold rigid, where some joint's equations are ones the
+    /// other constraints already impose (a loop closed twice): the joint is named first, at its
+    /// name, with the drivers as the other way out. (With freedom left, the drivers are what
+    /// is too many.)
+    fn joint_takes_drivers_freedom(
+        &mut self,
+        spec: &Spec,
+        joints: &[&Ident],
+        dof: i64,
+        count: &str,
+    ) {
+        let drivers = spec.drivers.len() as i64;
+        let extra = drivers - dof;
+        let (first, others) = joints.split_first().expect("a removable joint");
+        let driver = spec
+            .drivers
+            .get(dof as usize)
+            .map_or_else(String::new, |d| {
+                format!(
+                    ", or remove {extra} driver{}, such as `{}`",
+                    plural(extra),
+                    d.name
+                )
+            });
+        self.errors.push(
+            first.span(),
+            format!(
+                "too many constraints: `{}` has {dof} degree{} of freedom but {drivers} \
+                 driver{} ({count}), and joint `{first}` over-constrains it: the other joints \
+                 and the drivers already impose its equations; {}{driver}",
+                spec.name,
+                plural(dof),
+                plural(drivers),
+                remove_joint(first, others),
+            ),
+        );
     }
 
     /// A parameter default: a constant expression.
@@ -721,9 +798,14 @@ impl Structure {
     /// The structure of a model's Φ: the equations are built into the model's arena (the same
     /// hash-consed nodes `kinematics` derives from later) and each one's coordinates read off.
     pub fn of_model(model: &mut Model) -> Self {
+        let rows = Self::rows_of(model);
+        Self::of_pattern(&rows, model.dim())
+    }
+
+    /// The coordinates each of a model's equations touches, in Φ order.
+    pub fn rows_of(model: &mut Model) -> Vec<Vec<usize>> {
         let phi = crate::kinematics::constraint_equations(model);
-        let rows: Vec<Vec<usize>> = phi
-            .iter()
+        phi.iter()
             .map(|&e| {
                 model
                     .arena
@@ -735,8 +817,7 @@ impl Structure {
                     })
                     .collect()
             })
-            .collect();
-        Self::of_pattern(&rows, model.dim())
+            .collect()
     }
 
     /// The structure of a pattern: `rows[i]` lists the coordinates (`< columns`) equation `i`
@@ -907,6 +988,17 @@ fn coordinate_name(model: &Model, coordinate: usize) -> String {
         .unwrap_or_default()
 }
 
+/// "remove joint `a` (or `b`, `c`)".
+fn remove_joint(first: &Ident, others: &[&Ident]) -> String {
+    let or = if others.is_empty() {
+        String::new()
+    } else {
+        let names: Vec<String> = others.iter().map(|j| format!("`{j}`")).collect();
+        format!(" (or {})", names.join(", "))
+    };
+    format!("remove joint `{first}`{or}")
+}
+
 fn plural(n: i64) -> &'static str {
     if n == 1 { "" } else { "s" }
 }
@@ -964,6 +1056,31 @@ mod tests {
 
     fn scene(extra: &str) -> String {
         format!("mechanism M {{ {SLIDER} {extra} }}")
+    }
+
+    #[test]
+    fn the_joint_that_over_constrains_is_named_first() {
+        // A distance the loop already imposes: the joint, not the driver, is the culprit.
+        let extra = errors(&scene(
+            "joint extra: distance(frame, rod @ (2, 0), 3); driver d: angle(crank) = t;",
+        ));
+        assert_eq!(extra.len(), 1, "{extra:?}");
+        assert!(
+            extra[0].contains("joint `extra` over-constrains it")
+                && extra[0].ends_with("remove joint `extra`, or remove 1 driver, such as `d`"),
+            "{extra:?}"
+        );
+        // A copy of a joint: both are named, the later one first.
+        let copy = errors(&scene(
+            "joint copy: revolute(rod @ (2, 0), slider); driver d: angle(crank) = t;",
+        ));
+        assert_eq!(copy.len(), 1, "{copy:?}");
+        assert!(copy[0].contains("remove joint `copy` (or `b`)"), "{copy:?}");
+        // With freedom left, surplus drivers are still the drivers' fault.
+        let drivers = errors(&scene(
+            "driver d: angle(crank) = t; driver e: x(slider) = 3 + t;",
+        ));
+        assert!(drivers[0].starts_with("too many drivers"), "{drivers:?}");
     }
 
     #[test]
