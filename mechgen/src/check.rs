@@ -1110,6 +1110,52 @@ mod tests {
     }
 
     #[test]
+    fn unknown_functions_suggest_what_to_write() {
+        let msgs = errors(&scene(
+            "driver d: angle(crank) = atan(t) + pow(t, 2) + sinn(t) + cosh(t) + frob(t);",
+        ));
+        let all = msgs.join("\n");
+        for expected in [
+            "unknown function `atan`; write `atan2(y, x)`",
+            "unknown function `pow`; write the power operator: `a^b` for `pow(a, b)`",
+            "unknown function `sinn`; did you mean `sin(x)`?",
+            "unknown function `cosh`; write `(exp(x) + exp(-x)) / 2`",
+            "unknown function `frob`; supported functions are `sin(x)`",
+        ] {
+            assert!(all.contains(expected), "{expected}: {all}");
+        }
+    }
+
+    #[test]
+    fn spline_knots_must_be_resolvable() {
+        let tiny = errors(&scene(
+            "driver d: angle(crank) = spline(t, (0, 0), (1e-300, 1));",
+        ));
+        assert_eq!(
+            tiny,
+            [
+                "a spline's x values 0 and 1e-300 are 1e-300 apart; knots must be spaced at least \
+              1e-100 (the spline's slopes and curvatures, its values over the spacing and its \
+              square, would overflow): merge the two points or space them further apart"
+            ]
+        );
+        let close = errors(&scene(
+            "driver d: angle(crank) = spline(t, (1e6, 0), (1000000.00000001, 1));",
+        ));
+        assert!(
+            close[0].contains("at least 1e-12 of the x values' size"),
+            "{close:?}"
+        );
+        // Spacings double precision resolves are fine, however small the scene's unit.
+        assert!(
+            errors(&scene(
+                "driver d: angle(crank) = spline(t, (0, 0), (1e-90, 1));"
+            ))
+            .is_empty()
+        );
+    }
+
+    #[test]
     fn degrees_of_freedom_must_match_drivers() {
         let missing = errors(&scene("")).join("\n");
         assert!(
@@ -1129,6 +1175,47 @@ mod tests {
         assert!(msgs.contains("duplicate name `crank`"), "{msgs}");
         let msgs = errors(&scene("param t = 1; driver d: angle(crank) = t;")).join("\n");
         assert!(msgs.contains("`t` is time"), "{msgs}");
+    }
+
+    /// The unit axis of the slider's prismatic joint for `along (ux, uy)`, with `w` set to
+    /// `w` (a parameter the axis may read).
+    fn unit_axis(along: &str, w: f64) -> [f64; 2] {
+        let source = format!(
+            "mechanism M {{ param w = {w}; ground f at (0, 0, 0); body b near (0, 0, 0);
+               joint p: prismatic(f, b, along ({along})); driver d: travel(p) = t; }}"
+        );
+        let spec = parse_str(&source).unwrap_or_else(|e| panic!("{e}"));
+        let model = check(&spec).unwrap_or_else(|e| panic!("{along}: {e}"));
+        let axis = model.constraints.iter().find_map(|c| match c.kind {
+            ConstraintKind::Prismatic { axis, .. } => Some(axis),
+            _ => None,
+        });
+        let env = crate::interpret::Env {
+            params: vec![w],
+            ..Default::default()
+        };
+        axis.expect("a prismatic joint")
+            .map(|id| crate::interpret::eval(&model.arena, id, &env))
+    }
+
+    #[test]
+    fn axes_are_normalised_without_squaring_their_length() {
+        // 1e-170² underflows to zero and 1e160² overflows: both are the direction (0, 1).
+        for along in ["0, 1e-170", "0, 1e160", "0, w", "0, 1"] {
+            for w in [1e-170, 1e160, 3.0] {
+                assert_eq!(unit_axis(along, w), [0.0, 1.0], "along ({along}), w = {w}");
+            }
+        }
+        let [x, y] = unit_axis("-3e200, 4e200", 1.0);
+        assert!(
+            (x + 0.6).abs() < 1e-15 && (y - 0.8).abs() < 1e-15,
+            "{x}, {y}"
+        );
+        let [x, y] = unit_axis("3 * w, -4 * w", 1e-200);
+        assert!(
+            (x - 0.6).abs() < 1e-15 && (y + 0.8).abs() < 1e-15,
+            "{x}, {y}"
+        );
     }
 
     #[test]
