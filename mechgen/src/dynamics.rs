@@ -105,31 +105,46 @@ pub fn derive(model: &mut Model) -> Vec<Id> {
         }
     }
     for load in loads {
-        match load {
-            LoadKind::Force {
-                point,
-                value,
-                local,
-            } => {
-                let value = if local {
-                    w.frames.rotate(point.body, value)
-                } else {
-                    value
-                };
-                let at = w.frames.world_point(point);
-                w.apply(value, at);
-            }
-            LoadKind::Torque { body, value } => w.torque(body, value),
-            LoadKind::Spring {
-                a,
-                b,
-                stiffness,
-                length,
-                damping,
-            } => w.spring(a, b, [stiffness, length, damping]),
-        }
+        w.load(load);
     }
     w.forces
+}
+
+/// Two values per load, for naming the load that makes F non-finite (on the failure path of
+/// the force solve, `mechgen_runtime::first_load_fault`): the sum of its contributions to F,
+/// finite exactly when they all are, and for a spring the squared distance between its ends
+/// (its direction is undefined where they meet), 1 for other loads.
+pub fn load_witnesses(model: &mut Model) -> Vec<Id> {
+    let poses = ground_poses(model);
+    let loads: Vec<LoadKind> = model.loads.iter().map(|l| l.kind).collect();
+    let n = model.dim();
+    let (zero, one) = (model.arena.zero(), model.arena.one());
+    let mut w = Work {
+        frames: Frames {
+            arena: &mut model.arena,
+            poses: &poses,
+        },
+        d: Differentiator::new(),
+        forces: vec![zero; n],
+    };
+    let mut witnesses = Vec::with_capacity(2 * loads.len());
+    for load in loads {
+        w.forces.fill(zero);
+        w.load(load);
+        let sum = w
+            .forces
+            .iter()
+            .fold(zero, |sum, &f| w.frames.arena.add(sum, f));
+        let separation = match load {
+            LoadKind::Spring { a, b, .. } => {
+                let d = w.frames.separation(a, b);
+                w.frames.dot(d, d)
+            }
+            _ => one,
+        };
+        witnesses.extend([sum, separation]);
+    }
+    witnesses
 }
 
 /// The forces gathered so far, and what builds them.
@@ -142,6 +157,33 @@ struct Work<'a> {
 impl Work<'_> {
     fn arena(&mut self) -> &mut Arena {
         self.frames.arena
+    }
+
+    /// Adds one load's contributions.
+    fn load(&mut self, load: LoadKind) {
+        match load {
+            LoadKind::Force {
+                point,
+                value,
+                local,
+            } => {
+                let value = if local {
+                    self.frames.rotate(point.body, value)
+                } else {
+                    value
+                };
+                let at = self.frames.world_point(point);
+                self.apply(value, at);
+            }
+            LoadKind::Torque { body, value } => self.torque(body, value),
+            LoadKind::Spring {
+                a,
+                b,
+                stiffness,
+                length,
+                damping,
+            } => self.spring(a, b, [stiffness, length, damping]),
+        }
     }
 
     /// `forces[k] += value`.

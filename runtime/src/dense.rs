@@ -211,6 +211,14 @@ where
     fn reaction_name(&self, index: usize) -> Option<&str> {
         self.inner.reaction_name(index)
     }
+    fn load_fault(
+        &self,
+        q: &Vector<M::Dim>,
+        qd: &Vector<M::Dim>,
+        t: f64,
+    ) -> Option<crate::Quantity> {
+        self.inner.load_fault(q, qd, t)
+    }
 }
 
 impl<M: Velocities> Velocities for Dense<M> where DefaultAllocator: Storage<M::Dim> {}

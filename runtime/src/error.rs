@@ -36,13 +36,37 @@ pub enum Quantity {
     Acceleration,
     /// A branch invariant of the scene (its index).
     Branch(usize),
-    /// The generalised applied and inertial forces F of the force solve (a load's expression,
-    /// a spring of zero length, an overflowing inertia force).
+    /// The generalised applied and inertial forces F of the force solve as a whole, when no
+    /// single load explains them ([`Quantity::LoadValue`] and [`Quantity::SpringEnds`] name
+    /// one): the masses' inertia or gravity overflowing.
     Load,
     /// The solved reactions (Lagrange multipliers) of the force solve.
     Reaction,
     /// A marker's value or rate (its index among the marker values).
     Marker(usize),
+    /// One load's force or moment (its index among the scene's loads): its expression or the
+    /// parameters it reads (a moment of 1e310, a division by zero).
+    LoadValue(usize),
+    /// A spring's force where its ends coincide (its index among the scene's loads): with a
+    /// non-zero free length its direction, and so its force, is undefined there.
+    SpringEnds(usize),
+}
+
+/// The first load, among [`crate::Mechanism::load_fault`]'s witnesses (two values per load:
+/// the sum of its contributions to F, and for a spring the squared distance between its ends,
+/// else 1), whose contribution is not finite: [`Quantity::SpringEnds`] when the ends meet,
+/// [`Quantity::LoadValue`] otherwise. Generated scenes and the interpreter call it.
+pub fn first_load_fault(witnesses: &[f64]) -> Option<Quantity> {
+    witnesses
+        .chunks_exact(2)
+        .position(|w| !w[0].is_finite())
+        .map(|load| {
+            if witnesses.get(2 * load + 1).is_some_and(|&d| d == 0.0) {
+                Quantity::SpringEnds(load)
+            } else {
+                Quantity::LoadValue(load)
+            }
+        })
 }
 
 impl Quantity {
@@ -61,6 +85,14 @@ impl Quantity {
             Self::Marker(index) => {
                 f.write_str("marker value ")?;
                 return write_name(f, names.marker(index), index);
+            }
+            Self::LoadValue(index) => {
+                f.write_str("the force or moment of load ")?;
+                return write_name(f, names.load(index), index);
+            }
+            Self::SpringEnds(index) => {
+                f.write_str("the force of spring ")?;
+                return write_name(f, names.load(index), index);
             }
             Self::Time => "the time",
             Self::Guess => "the positions q (initial guess)",
@@ -277,6 +309,7 @@ trait Lookup {
     fn parameter(&self, index: usize) -> Option<&str>;
     fn branch(&self, index: usize) -> Option<&str>;
     fn marker(&self, index: usize) -> Option<&str>;
+    fn load(&self, index: usize) -> Option<&str>;
 }
 
 impl Lookup for Names {
@@ -294,6 +327,9 @@ impl Lookup for Names {
     }
     fn marker(&self, index: usize) -> Option<&str> {
         Names::marker(self, index)
+    }
+    fn load(&self, index: usize) -> Option<&str> {
+        Names::load(self, index)
     }
 }
 
@@ -318,6 +354,9 @@ where
     }
     fn marker(&self, index: usize) -> Option<&str> {
         self.0.marker_name(index).or(self.1.marker(index))
+    }
+    fn load(&self, index: usize) -> Option<&str> {
+        self.0.names().load(index).or(self.1.load(index))
     }
 }
 
@@ -512,6 +551,17 @@ impl SolveError {
             } => {
                 quantity.write(f, names)?;
                 write!(f, " became NaN or infinite at t = {time}")?;
+                match quantity {
+                    Quantity::SpringEnds(_) => f.write_str(
+                        ": its ends coincide, where a spring of non-zero free length has no \
+                         direction (give it free length 0, or keep its ends apart)",
+                    )?,
+                    Quantity::LoadValue(_) => f.write_str(
+                        " (check its expression and the parameters it reads for an overflow, a \
+                         division by zero or a square root of a negative number at this time)",
+                    )?,
+                    _ => {}
+                }
                 if let Some(index) = index {
                     f.write_str(", first in equation ")?;
                     equation(f, index)?;
@@ -707,6 +757,14 @@ mod tests {
                 &["marker value `tip.x`"]
             ),
             (
+                non_finite(Quantity::LoadValue(0), None),
+                &["the force or moment of load `gas`"]
+            ),
+            (
+                non_finite(Quantity::SpringEnds(0), None),
+                &["the force of spring `gas`", "its ends coincide"]
+            ),
+            (
                 non_finite(Quantity::Phi, Some(0)),
                 &["first in equation `pivot.x`"]
             ),
@@ -757,6 +815,20 @@ mod tests {
                     || expected[0].contains("Linkage")
             );
         }
+    }
+
+    #[test]
+    fn the_first_non_finite_load_is_named_with_its_cause() {
+        let nan = f64::NAN;
+        assert_eq!(first_load_fault(&[1.0, 1.0, 2.0, 0.0]), None);
+        assert_eq!(
+            first_load_fault(&[1.0, 1.0, nan, 0.0, nan, 1.0]),
+            Some(Quantity::SpringEnds(1))
+        );
+        assert_eq!(
+            first_load_fault(&[f64::INFINITY, 1.0, nan, 0.0]),
+            Some(Quantity::LoadValue(0))
+        );
     }
 
     #[test]

@@ -80,7 +80,7 @@ mod workspace;
 
 pub use assembly::{AssemblyError, GUESS_TIME, MAX_CONTINUATION_STEPS};
 pub use dense::{Dense, DenseBuffers};
-pub use error::{Described, Quantity, SolveError};
+pub use error::{Described, Quantity, SolveError, first_load_fault};
 pub use geometry::{GeometryFault, MAX_LENGTH, Requirement, check_geometry};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use markers::{

@@ -382,6 +382,19 @@ where
         None
     }
 
+    /// On the force solve's failure path, with F not finite: the first load whose force or
+    /// moment is not, at the state `(q, q̇)` and `t` ([`crate::Quantity::LoadValue`], or
+    /// [`crate::Quantity::SpringEnds`] for a spring whose ends meet), so that the error names
+    /// it. The default finds none (F is then blamed as a whole: the masses' inertia).
+    fn load_fault(
+        &self,
+        _q: &Vector<Self::Dim>,
+        _qd: &Vector<Self::Dim>,
+        _t: f64,
+    ) -> Option<crate::Quantity> {
+        None
+    }
+
     /// Name of the reaction [`Mechanism::reactions`] writes for equation `index`, such as
     /// `"crank_pin.fx"` or `"crank_angle.effort"`; `None` past the end or for a scene that does
     /// not compute forces.

@@ -47,6 +47,75 @@ mechanism! {
     }
 }
 
+mechanism! {
+    /// An arm with a moment and a spring anchored at its pivot: the spring's ends always meet.
+    pub mechanism Loaded {
+        /// The moment's scale.
+        param moment = 1.0;
+        /// The spring's free length.
+        param rest = 0.0;
+        gravity (0, -9.81);
+        ground frame at (0, 0, 0);
+        body arm near (1, 0, 0) mass 1 inertia 0.1;
+        joint pivot: revolute(frame, arm @ (-1, 0));
+        driver swing: angle(arm) = t;
+        load brake: torque(arm) = 10 * moment;
+        load valve: spring(frame, arm @ (-1, 0), stiffness 20, length rest);
+    }
+}
+
+const LOADED: &str = "mechanism Loaded {
+    param moment = 1.0;
+    param rest = 0.0;
+    gravity (0, -9.81);
+    ground frame at (0, 0, 0);
+    body arm near (1, 0, 0) mass 1 inertia 0.1;
+    joint pivot: revolute(frame, arm @ (-1, 0));
+    driver swing: angle(arm) = t;
+    load brake: torque(arm) = 10 * moment;
+    load valve: spring(frame, arm @ (-1, 0), stiffness 20, length rest);
+}";
+
+/// A force solve that meets a non-finite F names the load and the cause: an overflowing
+/// moment, and a spring of non-zero free length whose ends meet.
+fn load_failures<M: Structured + Clone>(loaded: M)
+where
+    mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
+{
+    let mut spring = loaded.clone();
+    set_parameter(&mut spring, "rest", 3.0);
+    let error = Simulation::new(Solver::new(spring), 0.0)
+        .err()
+        .unwrap()
+        .error;
+    assert_eq!(
+        format!("{error:?}"),
+        "NonFinite: the force of spring `valve` became NaN or infinite at t = 0: its ends \
+         coincide, where a spring of non-zero free length has no direction (give it free length \
+         0, or keep its ends apart)"
+    );
+    // The moment is declared first: it is named, whatever the spring does.
+    let mut moment = loaded;
+    set_parameter(&mut moment, "moment", 1e308);
+    let error = Simulation::new(Solver::new(moment), 0.0)
+        .err()
+        .unwrap()
+        .error;
+    assert_named(
+        &error,
+        "NonFinite",
+        &["the force or moment of load `brake`"],
+    );
+}
+
+#[test]
+fn a_non_finite_load_is_named_with_its_cause() {
+    load_failures(Loaded::default());
+    let scene = interpreted(LOADED);
+    assert_eq!(scene.names(), &Loaded::NAMES);
+    load_failures(scene);
+}
+
 const NAMED: &str = "mechanism Named {
     param reach = 100.0;
     param rod = 120.0;

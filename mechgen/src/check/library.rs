@@ -322,6 +322,13 @@ impl Checker {
             );
             None
         };
+        if !self.arena.simplifies() {
+            // The naive baseline (`CodegenOptions::naive`) keeps the textbook formula.
+            let (ux2, uy2) = (self.arena.powi(ux, 2), self.arena.powi(uy, 2));
+            let norm2 = self.arena.add(ux2, uy2);
+            let norm = self.arena.call(Func::Sqrt, norm2);
+            return Some([self.arena.div(ux, norm), self.arena.div(uy, norm)]);
+        }
         if let (Some(x), Some(y)) = (self.arena.as_const(ux), self.arena.as_const(uy)) {
             let length = x.hypot(y);
             if length == 0.0 {

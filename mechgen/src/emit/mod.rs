@@ -62,6 +62,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
         kinematics_branches: &scene.kinematics.branches,
         forces: scene.forces.as_ref(),
         markers: &scene.kinematics.markers,
+        load_witnesses: &scene.load_witnesses,
         options,
         helpers: RefCell::new(Vec::new()),
     };
