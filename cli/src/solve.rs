@@ -4,7 +4,9 @@
 use std::io::Write;
 
 use mechgen_runtime::nalgebra::DVector;
-use mechgen_runtime::{Mechanism, Simulation, SolveError, Solver, State, write_csv_header};
+use mechgen_runtime::{
+    Mechanism, Quantity, Simulation, SolveError, Solver, State, write_csv_header,
+};
 
 use crate::Interpreted;
 
@@ -94,6 +96,10 @@ pub fn assemble(mechanism: Interpreted, t0: f64) -> Result<Simulation<Interprete
 const GEOMETRY_HINT: &str = "change the named parameter with `--set NAME=VALUE` (its default is in the scene; \
      `mechgen check FILE` lists the parameters)";
 
+const LOAD_HINT: &str = "the named load is not finite at this time: check its expression and the \
+     parameters it reads (with `--set NAME=VALUE`); a spring of non-zero free length needs its \
+     ends apart";
+
 fn assembly_hint(error: &SolveError) -> &'static str {
     match error {
         SolveError::NoConvergence { .. } => {
@@ -117,6 +123,10 @@ fn assembly_hint(error: &SolveError) -> &'static str {
              positions near the scene's size, and check parameters that set huge values"
         }
         SolveError::Geometry { .. } => GEOMETRY_HINT,
+        SolveError::NonFinite {
+            quantity: Quantity::LoadValue(_) | Quantity::SpringEnds(_),
+            ..
+        } => LOAD_HINT,
         _ => "check the parameter values and the `near` guesses for divisions by zero",
     }
 }
@@ -144,6 +154,10 @@ fn step_hint(error: &SolveError) -> &'static str {
              turns?): start the run at a smaller time, or drive the angle with a periodic law"
         }
         SolveError::Geometry { .. } => GEOMETRY_HINT,
+        SolveError::NonFinite {
+            quantity: Quantity::LoadValue(_) | Quantity::SpringEnds(_),
+            ..
+        } => LOAD_HINT,
         _ => "a value became NaN or infinite: check the parameter values and the time range",
     }
 }

@@ -299,6 +299,30 @@ fn check_points_at_the_joint_that_over_constrains() {
     }
 }
 
+/// A spring whose ends meet, with a non-zero free length: `solve` names the spring, the
+/// cause and what to do.
+#[test]
+fn solve_names_the_load_whose_force_is_not_finite() {
+    let seed = std::fs::read_to_string(scene("piston_crank_dynamics.mech")).expect("seed");
+    let source = seed.replace(
+        "    joint slide:",
+        "    load valve: spring(rod @ (41.3, 0), crank @ (0, 43), stiffness 20, length 35);\n    \
+         joint slide:",
+    );
+    let path = scratch("coincident_spring.mech");
+    std::fs::write(&path, &source).expect("scene written");
+    let out = mechgen(&["solve", path.to_str().expect("UTF-8 path"), "--at", "0"]);
+    assert_eq!(out.status.code(), Some(1));
+    let errors = text(&out.stderr);
+    assert!(
+        errors.contains(
+            "the force of spring `valve` became NaN or infinite at t = 0: its ends coincide"
+        ) && errors.contains("hint: the named load is not finite at this time"),
+        "{errors}"
+    );
+    let _ = std::fs::remove_file(&path);
+}
+
 #[test]
 fn unreadable_files_say_so() {
     let out = mechgen(&["check", "no/such/scene.mech"]);
