@@ -97,8 +97,8 @@ const GEOMETRY_HINT: &str = "change the named parameter with `--set NAME=VALUE` 
      `mechgen check FILE` lists the parameters)";
 
 const LOAD_HINT: &str = "the named load is not finite at this time: check its expression and the \
-     parameters it reads (with `--set NAME=VALUE`); a spring of non-zero free length needs its \
-     ends apart";
+     parameters it reads (with `--set NAME=VALUE`); a spring with a free length or damping needs \
+     its ends apart";
 
 fn assembly_hint(error: &SolveError) -> &'static str {
     match error {

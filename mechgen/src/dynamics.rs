@@ -245,8 +245,9 @@ impl Work<'_> {
     /// pulling `a` by `T d/ℓ` and `b` by the opposite (toward each other when stretched).
     ///
     /// Written per unit length, `T/ℓ = k (1 − L/ℓ) + c (d·ḋ)/ℓ²`, so that a zero-length
-    /// spring's force `k d` stays finite where its points meet; otherwise its direction, and
-    /// the force, are undefined there.
+    /// spring's force `k d` stays finite where its points meet, also when its length is a
+    /// parameter set to 0 (`L/ℓ` is selected away, not computed as 0/0); otherwise its
+    /// direction, and the force, are undefined there.
     fn spring(&mut self, a: Point, b: Point, [stiffness, length, damping]: [Id; 3]) {
         let (at_a, at_b) = (self.frames.world_point(a), self.frames.world_point(b));
         let d = self.frames.separation(a, b);
@@ -256,7 +257,11 @@ impl Work<'_> {
         let arena = &mut *self.frames.arena;
         let distance = arena.call(Func::Sqrt, squared);
         let rest = arena.mul(stiffness, length);
-        let shrink = arena.div(rest, distance);
+        let ratio = arena.div(rest, distance);
+        let zero = arena.zero();
+        let negative = arena.neg(rest);
+        let size = arena.select(zero, rest, rest, negative);
+        let shrink = arena.select(size, zero, zero, ratio);
         let elastic = arena.sub(stiffness, shrink);
         let damped = arena.mul(damping, approach);
         let viscous = arena.div(damped, squared);

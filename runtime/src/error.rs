@@ -48,7 +48,7 @@ pub enum Quantity {
     /// parameters it reads (a moment of 1e310, a division by zero).
     LoadValue(usize),
     /// A spring's force where its ends coincide (its index among the scene's loads): with a
-    /// non-zero free length its direction, and so its force, is undefined there.
+    /// non-zero free length or damping its direction, and so its force, is undefined there.
     SpringEnds(usize),
 }
 
@@ -553,8 +553,9 @@ impl SolveError {
                 write!(f, " became NaN or infinite at t = {time}")?;
                 match quantity {
                     Quantity::SpringEnds(_) => f.write_str(
-                        ": its ends coincide, where a spring of non-zero free length has no \
-                         direction (give it free length 0, or keep its ends apart)",
+                        ": its ends coincide, where a spring with a free length or damping has \
+                         no direction (give it free length 0 and no damping, or keep its ends \
+                         apart)",
                     )?,
                     Quantity::LoadValue(_) => f.write_str(
                         " (check its expression and the parameters it reads for an overflow, a \

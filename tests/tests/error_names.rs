@@ -82,6 +82,10 @@ fn load_failures<M: Structured + Clone>(loaded: M)
 where
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<M::Dim>,
 {
+    // Zero free length, a parameter: the spring's force is finite where its ends meet.
+    if let Err(e) = Simulation::new(Solver::new(loaded.clone()), 0.0) {
+        panic!("{e}");
+    }
     let mut spring = loaded.clone();
     set_parameter(&mut spring, "rest", 3.0);
     let error = Simulation::new(Solver::new(spring), 0.0)
@@ -91,8 +95,8 @@ where
     assert_eq!(
         format!("{error:?}"),
         "NonFinite: the force of spring `valve` became NaN or infinite at t = 0: its ends \
-         coincide, where a spring of non-zero free length has no direction (give it free length \
-         0, or keep its ends apart)"
+         coincide, where a spring with a free length or damping has no direction (give it free \
+         length 0 and no damping, or keep its ends apart)"
     );
     // The moment is declared first: it is named, whatever the spring does.
     let mut moment = loaded;
