@@ -16,10 +16,11 @@ use mechgen::interpret::{Inputs, Tape};
 use mechgen::kinematics::LengthScale;
 use mechgen::reactions::ForceStage;
 use mechgen::structure::{self, Phase, Plan};
+use mechgen_runtime::first_load_fault;
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{
-    Accelerations, Block, Forces, GeometryFault, Matrix, Mechanism, Outputs, ParameterError,
-    Pattern, Requirement, Stage, Structured, Unit, VecBuffers, Vector, Velocities,
+    Accelerations, Block, Forces, GeometryFault, Matrix, Mechanism, Names, Outputs, ParameterError,
+    Pattern, Quantity, Requirement, Stage, Structured, Unit, VecBuffers, Vector, Velocities,
 };
 
 /// A scene whose kinematics are interpreted rather than generated.
@@ -42,6 +43,9 @@ pub struct Interpreted {
     /// The force solve's textbook functions (F, and the reactions from λ), and the reactions'
     /// names, present when the scene computes forces.
     forces: Option<(Tape, Tape)>,
+    /// Two values per load naming the one that makes F non-finite (`Scene::load_witnesses`),
+    /// and how many values that is.
+    load_witnesses: (Tape, usize),
     reaction_names: Vec<String>,
     /// The markers' values: the textbook tape, the same reading the trig cache, and names.
     markers: (Tape, Tape),
@@ -58,6 +62,8 @@ pub struct Interpreted {
     geometry: Vec<geometry::Check>,
     geometry_values: Tape,
     branch_names: Vec<String>,
+    /// Every name, `'static` for the errors the solver returns (interned, see `names`).
+    names: &'static Names,
     /// One tape per branch invariant (its signed value), and the same reading the trig cache.
     branches: Vec<Tape>,
     cached_branches: Vec<Tape>,
@@ -284,6 +290,7 @@ impl Interpreted {
             Tape::with_inputs(arena, &kin.markers, &reads)
         };
         let markers = (Tape::new(arena, &kin.markers), cached_markers);
+        let load_witnesses = Tape::new(arena, &scene.load_witnesses);
         let force_storage = scene.forces.as_ref().map_or(0, |_| {
             model.dim() + plan.blocks().map(structure::Block::slots).sum::<usize>()
         });
@@ -302,7 +309,7 @@ impl Interpreted {
             .chain(&nu)
             .chain(&gamma)
             .chain(forces.iter().flat_map(|(f, r)| [f, r]))
-            .chain([&markers.0, &markers.1])
+            .chain([&markers.0, &markers.1, &load_witnesses])
             .chain([&lengths, &geometry_values])
             .chain(&branches)
             .chain(&cached_branches)
@@ -317,6 +324,7 @@ impl Interpreted {
             .max(kin.geometry.len())
             .max(plan.largest_block() + plan.largest_slots())
             .max(kin.markers.len())
+            .max(scene.load_witnesses.len())
             .max(1);
         let [guess, phi, jacobian, phi_and_jacobian] = tapes;
         let outputs = match model.outputs {
@@ -339,6 +347,7 @@ impl Interpreted {
             nu,
             gamma,
             forces,
+            load_witnesses: (load_witnesses, scene.load_witnesses.len()),
             reaction_names: model.reaction_names(),
             markers,
             marker_names: model.marker_names(),
@@ -351,6 +360,15 @@ impl Interpreted {
             geometry: kin.geometry.clone(),
             geometry_values,
             branch_names: model.branches.iter().map(|b| b.name.clone()).collect(),
+            names: crate::names::intern([
+                vec![model.name.to_string()],
+                model.coordinate_names(),
+                model.equation_names(),
+                model.params.iter().map(|p| p.name.to_string()).collect(),
+                model.branches.iter().map(|b| b.name.clone()).collect(),
+                model.marker_names(),
+                model.loads.iter().map(|l| l.name.clone()).collect(),
+            ]),
             branches,
             cached_branches,
             stages,
@@ -475,6 +493,10 @@ impl Mechanism for Interpreted {
 
     fn dim(&self) -> Dyn {
         Dyn(self.coordinates.len())
+    }
+
+    fn names(&self) -> &'static Names {
+        self.names
     }
 
     fn coordinate_name(&self, index: usize) -> Option<&str> {
@@ -647,6 +669,16 @@ impl Mechanism for Interpreted {
             }
             None => out.as_mut_slice().fill(f64::NAN),
         }
+    }
+
+    fn load_fault(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, t: f64) -> Option<Quantity> {
+        let (tape, count) = &self.load_witnesses;
+        let mut fault = None;
+        let inputs = self.inputs(q.as_slice(), qd.as_slice(), t);
+        self.run(tape, inputs, |v| {
+            fault = first_load_fault(v.get(..*count).unwrap_or(v));
+        });
+        fault
     }
 
     fn reactions(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, lambda: &[f64], out: &mut Vector<Dyn>) {

@@ -9,6 +9,7 @@ pub mod args;
 pub mod diagnostics;
 pub mod inspect;
 mod interpreted;
+mod names;
 pub mod solve;
 
 use std::ffi::OsString;

@@ -5,7 +5,7 @@ use std::io::Write;
 
 use mechgen_runtime::nalgebra::DVector;
 use mechgen_runtime::{
-    GUESS_TIME, Mechanism, Simulation, SolveError, Solver, State, write_csv_header,
+    GUESS_TIME, Mechanism, Quantity, Simulation, SolveError, Solver, State, write_csv_header,
 };
 
 use crate::Interpreted;
@@ -181,6 +181,10 @@ pub fn write_unassembled(
 const GEOMETRY_HINT: &str = "change the named parameter with `--set NAME=VALUE` (its default is in the scene; \
      `mechgen check FILE` lists the parameters)";
 
+const LOAD_HINT: &str = "the named load is not finite at this time: check its expression and the \
+     parameters it reads (with `--set NAME=VALUE`); a spring with a free length or damping needs \
+     its ends apart";
+
 fn assembly_hint(error: &SolveError) -> &'static str {
     match error {
         SolveError::NoConvergence { .. } => {
@@ -211,6 +215,10 @@ fn assembly_hint(error: &SolveError) -> &'static str {
             "start the run nearer t = 0 (`--t0`), or write the drivers so that the motion of \
              interest starts near t = 0"
         }
+        SolveError::NonFinite {
+            quantity: Quantity::LoadValue(_) | Quantity::SpringEnds(_),
+            ..
+        } => LOAD_HINT,
         _ => "check the parameter values and the `near` guesses for divisions by zero",
     }
 }
@@ -238,6 +246,10 @@ fn step_hint(error: &SolveError) -> &'static str {
              turns?): start the run at a smaller time, or drive the angle with a periodic law"
         }
         SolveError::Geometry { .. } => GEOMETRY_HINT,
+        SolveError::NonFinite {
+            quantity: Quantity::LoadValue(_) | Quantity::SpringEnds(_),
+            ..
+        } => LOAD_HINT,
         _ => "a value became NaN or infinite: check the parameter values and the time range",
     }
 }

@@ -361,6 +361,71 @@ fn large_scenes_are_refused_before_they_are_read_and_errors_placed_in_any_chunk(
     let _ = std::fs::remove_file(&path);
 }
 
+/// The four-bar with one joint too many: `check` points at that joint, line and column.
+#[test]
+fn check_points_at_the_joint_that_over_constrains() {
+    let four_bar = std::fs::read_to_string(scene("four_bar.mech")).expect("four-bar");
+    let cases = [
+        (
+            "joint extra: distance(frame @ (80, 0), rocker @ (50, 0), 50);",
+            "joint `extra` over-constrains it",
+            "remove joint `extra`, or remove 1 driver, such as `crank_angle`",
+        ),
+        (
+            "joint extra: revolute(rocker, frame @ (100, 0));",
+            "joints `rocker_pivot`, `extra` over-determine body `rocker`",
+            "remove joint `extra` (or `rocker_pivot`)",
+        ),
+    ];
+    for (k, (joint, what, fix)) in cases.into_iter().enumerate() {
+        let path = scratch(&format!("over_constrained_{k}.mech"));
+        let source = four_bar.replace(
+            "    driver crank_angle",
+            &format!("    {joint}\n    driver crank_angle"),
+        );
+        std::fs::write(&path, &source).expect("scene written");
+        let name = path.to_str().expect("UTF-8 path");
+        let out = mechgen(&["check", name]);
+        assert_eq!(out.status.code(), Some(1));
+        let errors = text(&out.stderr);
+        let line = source
+            .lines()
+            .position(|l| l.contains("joint extra"))
+            .unwrap()
+            + 1;
+        assert!(
+            errors.contains(&format!("{name}:{line}:11: error: ")),
+            "{errors}"
+        );
+        assert!(errors.contains(what) && errors.contains(fix), "{errors}");
+        let _ = std::fs::remove_file(&path);
+    }
+}
+
+/// A spring whose ends meet, with a non-zero free length: `solve` names the spring, the
+/// cause and what to do.
+#[test]
+fn solve_names_the_load_whose_force_is_not_finite() {
+    let seed = std::fs::read_to_string(scene("piston_crank_dynamics.mech")).expect("seed");
+    let source = seed.replace(
+        "    joint slide:",
+        "    load valve: spring(rod @ (41.3, 0), crank @ (0, 43), stiffness 20, length 35);\n    \
+         joint slide:",
+    );
+    let path = scratch("coincident_spring.mech");
+    std::fs::write(&path, &source).expect("scene written");
+    let out = mechgen(&["solve", path.to_str().expect("UTF-8 path"), "--at", "0"]);
+    assert_eq!(out.status.code(), Some(1));
+    let errors = text(&out.stderr);
+    assert!(
+        errors.contains(
+            "the force of spring `valve` became NaN or infinite at t = 0: its ends coincide"
+        ) && errors.contains("hint: the named load is not finite at this time"),
+        "{errors}"
+    );
+    let _ = std::fs::remove_file(&path);
+}
+
 #[test]
 fn unreadable_files_say_so() {
     let out = mechgen(&["check", "no/such/scene.mech"]);

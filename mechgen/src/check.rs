@@ -10,6 +10,7 @@ mod dynamics;
 mod functions;
 mod library;
 mod points;
+mod redundancy;
 
 pub use constant::constant_value;
 
@@ -148,8 +149,9 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
         outputs,
     };
     if count {
-        let structure = Structure::of_model(&mut model);
-        cx.check_mobility(spec, &model, &structure);
+        let rows = Structure::rows_of(&mut model);
+        let structure = Structure::of_pattern(&rows, model.dim());
+        cx.check_mobility(spec, &model, &structure, &rows);
     }
     cx.lengths.check(&mut cx.errors);
     cx.errors.finish()?;
@@ -427,7 +429,13 @@ impl Checker {
     /// exactly the rest so that the system is square. A square system must then also be
     /// structurally non-singular ([`Structure`]): no group of constraints may over-determine
     /// some bodies while others keep free coordinates.
-    fn check_mobility(&mut self, spec: &Spec, model: &Model, structure: &Structure) {
+    fn check_mobility(
+        &mut self,
+        spec: &Spec,
+        model: &Model,
+        structure: &Structure,
+        rows: &[Vec<usize>],
+    ) {
         if self.check_floating(spec) {
             // A count would only blame the drivers for a body nothing holds.
             return;
@@ -446,6 +454,20 @@ impl Checker {
                 dof.to_string()
             },
         );
+        // The joints (and drivers) whose equations the others already impose, last declared
+        // first: the likeliest to have been added by mistake.
+        // A pin repeating an earlier one comes first, alone (its equations are the other's).
+        let over = structure.over_constraints(model);
+        let mut removable = redundancy::removable(model, rows, structure.rank, &over);
+        removable.reverse();
+        if let Some(&(later, earlier)) = redundancy::repeated_pins(model, &over).last() {
+            removable = vec![later, earlier];
+        }
+        let ground = model.bodies.iter().filter(|b| b.ground).count();
+        let joints: Vec<&Ident> = removable
+            .iter()
+            .filter_map(|&k| spec.joints.get(k.checked_sub(ground)?).map(|j| &j.name))
+            .collect();
         if dof < 0 {
             let part = if structure.over_equations.is_empty() {
                 String::new()
@@ -457,13 +479,30 @@ impl Checker {
                     structure.over_count(),
                 )
             };
-            self.errors.push(
-                spec.name.span(),
-                format!(
-                    "the joints over-constrain the mechanism ({count}){part}; remove joints or \
-                     add bodies"
+            // No joint whose equations are all redundant (without drivers, removing any
+            // joint frees a coordinate): the error goes to the last joint of the part.
+            let last = over
+                .iter()
+                .rev()
+                .find_map(|&k| spec.joints.get(k.checked_sub(ground)?));
+            let (span, fix) = match (joints.split_first(), last) {
+                (Some((first, others)), _) => (
+                    first.span(),
+                    format!(
+                        "{}: the other constraints already impose its equations",
+                        remove_joint(first, others)
+                    ),
                 ),
+                (None, Some(last)) => (last.name.span(), "remove joints or add bodies".to_owned()),
+                (None, None) => (spec.name.span(), "remove joints or add bodies".to_owned()),
+            };
+            self.errors.push(
+                span,
+                format!("the joints over-constrain the mechanism ({count}){part}; {fix}"),
             );
+        } else if dof == 0 && drivers > 0 && !joints.is_empty() {
+            // Drivers on a mechanism its joints hold rigid: a joint closed a loop twice.
+            self.joint_takes_drivers_freedom(spec, &joints, dof, &count);
         } else if drivers < dof {
             let missing = dof - drivers;
             let example = spec
@@ -581,6 +620,44 @@ impl Checker {
             }
         }
         (params, derived)
+    }
+
+    /// Drivers on a mechanism its joints hold rigid, where some joint's equations are ones the
+    /// other constraints already impose (a loop closed twice): the joint is named first, at its
+    /// name, with the drivers as the other way out. (With freedom left, the drivers are what
+    /// is too many.)
+    fn joint_takes_drivers_freedom(
+        &mut self,
+        spec: &Spec,
+        joints: &[&Ident],
+        dof: i64,
+        count: &str,
+    ) {
+        let drivers = spec.drivers.len() as i64;
+        let extra = drivers - dof;
+        let (first, others) = joints.split_first().expect("a removable joint");
+        let driver = spec
+            .drivers
+            .get(dof as usize)
+            .map_or_else(String::new, |d| {
+                format!(
+                    ", or remove {extra} driver{}, such as `{}`",
+                    plural(extra),
+                    d.name
+                )
+            });
+        self.errors.push(
+            first.span(),
+            format!(
+                "too many constraints: `{}` has {dof} degree{} of freedom but {drivers} \
+                 driver{} ({count}), and joint `{first}` over-constrains it: the other joints \
+                 and the drivers already impose its equations; {}{driver}",
+                spec.name,
+                plural(dof),
+                plural(drivers),
+                remove_joint(first, others),
+            ),
+        );
     }
 
     /// A parameter default: a constant expression.
@@ -833,9 +910,14 @@ impl Structure {
     /// The structure of a model's Φ: the equations are built into the model's arena (the same
     /// hash-consed nodes `kinematics` derives from later) and each one's coordinates read off.
     pub fn of_model(model: &mut Model) -> Self {
+        let rows = Self::rows_of(model);
+        Self::of_pattern(&rows, model.dim())
+    }
+
+    /// The coordinates each of a model's equations touches, in Φ order.
+    pub fn rows_of(model: &mut Model) -> Vec<Vec<usize>> {
         let phi = crate::kinematics::constraint_equations(model);
-        let rows: Vec<Vec<usize>> = phi
-            .iter()
+        phi.iter()
             .map(|&e| {
                 model
                     .arena
@@ -847,8 +929,7 @@ impl Structure {
                     })
                     .collect()
             })
-            .collect();
-        Self::of_pattern(&rows, model.dim())
+            .collect()
     }
 
     /// The structure of a pattern: `rows[i]` lists the coordinates (`< columns`) equation `i`
@@ -1019,6 +1100,17 @@ fn coordinate_name(model: &Model, coordinate: usize) -> String {
         .unwrap_or_default()
 }
 
+/// "remove joint `a` (or `b`, `c`)".
+fn remove_joint(first: &Ident, others: &[&Ident]) -> String {
+    let or = if others.is_empty() {
+        String::new()
+    } else {
+        let names: Vec<String> = others.iter().map(|j| format!("`{j}`")).collect();
+        format!(" (or {})", names.join(", "))
+    };
+    format!("remove joint `{first}`{or}")
+}
+
 fn plural(n: i64) -> &'static str {
     if n == 1 { "" } else { "s" }
 }
@@ -1079,6 +1171,31 @@ mod tests {
     }
 
     #[test]
+    fn the_joint_that_over_constrains_is_named_first() {
+        // A distance the loop already imposes: the joint, not the driver, is the culprit.
+        let extra = errors(&scene(
+            "joint extra: distance(frame, rod @ (2, 0), 3); driver d: angle(crank) = t;",
+        ));
+        assert_eq!(extra.len(), 1, "{extra:?}");
+        assert!(
+            extra[0].contains("joint `extra` over-constrains it")
+                && extra[0].ends_with("remove joint `extra`, or remove 1 driver, such as `d`"),
+            "{extra:?}"
+        );
+        // A copy of a joint: both are named, the later one first.
+        let copy = errors(&scene(
+            "joint copy: revolute(rod @ (2, 0), slider); driver d: angle(crank) = t;",
+        ));
+        assert_eq!(copy.len(), 1, "{copy:?}");
+        assert!(copy[0].contains("remove joint `copy` (or `b`)"), "{copy:?}");
+        // With freedom left, surplus drivers are still the drivers' fault.
+        let drivers = errors(&scene(
+            "driver d: angle(crank) = t; driver e: x(slider) = 3 + t;",
+        ));
+        assert!(drivers[0].starts_with("too many drivers"), "{drivers:?}");
+    }
+
+    #[test]
     fn a_valid_scene_checks() {
         let spec = parse_str(&scene("driver d: angle(crank) = w * t;"))
             .unwrap_or_else(|e| panic!("parses: {e}"));
@@ -1105,6 +1222,52 @@ mod tests {
     }
 
     #[test]
+    fn unknown_functions_suggest_what_to_write() {
+        let msgs = errors(&scene(
+            "driver d: angle(crank) = atan(t) + pow(t, 2) + sinn(t) + cosh(t) + frob(t);",
+        ));
+        let all = msgs.join("\n");
+        for expected in [
+            "unknown function `atan`; write `atan2(y, x)`",
+            "unknown function `pow`; write the power operator: `a^b` for `pow(a, b)`",
+            "unknown function `sinn`; did you mean `sin(x)`?",
+            "unknown function `cosh`; write `(exp(x) + exp(-x)) / 2`",
+            "unknown function `frob`; supported functions are `sin(x)`",
+        ] {
+            assert!(all.contains(expected), "{expected}: {all}");
+        }
+    }
+
+    #[test]
+    fn spline_knots_must_be_resolvable() {
+        let tiny = errors(&scene(
+            "driver d: angle(crank) = spline(t, (0, 0), (1e-300, 1));",
+        ));
+        assert_eq!(
+            tiny,
+            [
+                "a spline's x values 0 and 1e-300 are 1e-300 apart; knots must be spaced at least \
+              1e-100 (the spline's slopes and curvatures, its values over the spacing and its \
+              square, would overflow): merge the two points or space them further apart"
+            ]
+        );
+        let close = errors(&scene(
+            "driver d: angle(crank) = spline(t, (1e6, 0), (1000000.00000001, 1));",
+        ));
+        assert!(
+            close[0].contains("at least 1e-12 of the x values' size"),
+            "{close:?}"
+        );
+        // Spacings double precision resolves are fine, however small the scene's unit.
+        assert!(
+            errors(&scene(
+                "driver d: angle(crank) = spline(t, (0, 0), (1e-90, 1));"
+            ))
+            .is_empty()
+        );
+    }
+
+    #[test]
     fn degrees_of_freedom_must_match_drivers() {
         let missing = errors(&scene("")).join("\n");
         assert!(
@@ -1124,6 +1287,47 @@ mod tests {
         assert!(msgs.contains("duplicate name `crank`"), "{msgs}");
         let msgs = errors(&scene("param t = 1; driver d: angle(crank) = t;")).join("\n");
         assert!(msgs.contains("`t` is time"), "{msgs}");
+    }
+
+    /// The unit axis of the slider's prismatic joint for `along (ux, uy)`, with `w` set to
+    /// `w` (a parameter the axis may read).
+    fn unit_axis(along: &str, w: f64) -> [f64; 2] {
+        let source = format!(
+            "mechanism M {{ param w = {w}; ground f at (0, 0, 0); body b near (0, 0, 0);
+               joint p: prismatic(f, b, along ({along})); driver d: travel(p) = t; }}"
+        );
+        let spec = parse_str(&source).unwrap_or_else(|e| panic!("{e}"));
+        let model = check(&spec).unwrap_or_else(|e| panic!("{along}: {e}"));
+        let axis = model.constraints.iter().find_map(|c| match c.kind {
+            ConstraintKind::Prismatic { axis, .. } => Some(axis),
+            _ => None,
+        });
+        let env = crate::interpret::Env {
+            params: vec![w],
+            ..Default::default()
+        };
+        axis.expect("a prismatic joint")
+            .map(|id| crate::interpret::eval(&model.arena, id, &env))
+    }
+
+    #[test]
+    fn axes_are_normalised_without_squaring_their_length() {
+        // 1e-170² underflows to zero and 1e160² overflows: both are the direction (0, 1).
+        for along in ["0, 1e-170", "0, 1e160", "0, w", "0, 1"] {
+            for w in [1e-170, 1e160, 3.0] {
+                assert_eq!(unit_axis(along, w), [0.0, 1.0], "along ({along}), w = {w}");
+            }
+        }
+        let [x, y] = unit_axis("-3e200, 4e200", 1.0);
+        assert!(
+            (x + 0.6).abs() < 1e-15 && (y - 0.8).abs() < 1e-15,
+            "{x}, {y}"
+        );
+        let [x, y] = unit_axis("3 * w, -4 * w", 1e-200);
+        assert!(
+            (x - 0.6).abs() < 1e-15 && (y + 0.8).abs() < 1e-15,
+            "{x}, {y}"
+        );
     }
 
     #[test]

@@ -105,31 +105,46 @@ pub fn derive(model: &mut Model) -> Vec<Id> {
         }
     }
     for load in loads {
-        match load {
-            LoadKind::Force {
-                point,
-                value,
-                local,
-            } => {
-                let value = if local {
-                    w.frames.rotate(point.body, value)
-                } else {
-                    value
-                };
-                let at = w.frames.world_point(point);
-                w.apply(value, at);
-            }
-            LoadKind::Torque { body, value } => w.torque(body, value),
-            LoadKind::Spring {
-                a,
-                b,
-                stiffness,
-                length,
-                damping,
-            } => w.spring(a, b, [stiffness, length, damping]),
-        }
+        w.load(load);
     }
     w.forces
+}
+
+/// Two values per load, for naming the load that makes F non-finite (on the failure path of
+/// the force solve, `mechgen_runtime::first_load_fault`): the sum of its contributions to F,
+/// finite exactly when they all are, and for a spring the squared distance between its ends
+/// (its direction is undefined where they meet), 1 for other loads.
+pub fn load_witnesses(model: &mut Model) -> Vec<Id> {
+    let poses = ground_poses(model);
+    let loads: Vec<LoadKind> = model.loads.iter().map(|l| l.kind).collect();
+    let n = model.dim();
+    let (zero, one) = (model.arena.zero(), model.arena.one());
+    let mut w = Work {
+        frames: Frames {
+            arena: &mut model.arena,
+            poses: &poses,
+        },
+        d: Differentiator::new(),
+        forces: vec![zero; n],
+    };
+    let mut witnesses = Vec::with_capacity(2 * loads.len());
+    for load in loads {
+        w.forces.fill(zero);
+        w.load(load);
+        let sum = w
+            .forces
+            .iter()
+            .fold(zero, |sum, &f| w.frames.arena.add(sum, f));
+        let separation = match load {
+            LoadKind::Spring { a, b, .. } => {
+                let d = w.frames.separation(a, b);
+                w.frames.dot(d, d)
+            }
+            _ => one,
+        };
+        witnesses.extend([sum, separation]);
+    }
+    witnesses
 }
 
 /// The forces gathered so far, and what builds them.
@@ -142,6 +157,33 @@ struct Work<'a> {
 impl Work<'_> {
     fn arena(&mut self) -> &mut Arena {
         self.frames.arena
+    }
+
+    /// Adds one load's contributions.
+    fn load(&mut self, load: LoadKind) {
+        match load {
+            LoadKind::Force {
+                point,
+                value,
+                local,
+            } => {
+                let value = if local {
+                    self.frames.rotate(point.body, value)
+                } else {
+                    value
+                };
+                let at = self.frames.world_point(point);
+                self.apply(value, at);
+            }
+            LoadKind::Torque { body, value } => self.torque(body, value),
+            LoadKind::Spring {
+                a,
+                b,
+                stiffness,
+                length,
+                damping,
+            } => self.spring(a, b, [stiffness, length, damping]),
+        }
     }
 
     /// `forces[k] += value`.
@@ -203,8 +245,9 @@ impl Work<'_> {
     /// pulling `a` by `T d/ℓ` and `b` by the opposite (toward each other when stretched).
     ///
     /// Written per unit length, `T/ℓ = k (1 − L/ℓ) + c (d·ḋ)/ℓ²`, so that a zero-length
-    /// spring's force `k d` stays finite where its points meet; otherwise its direction, and
-    /// the force, are undefined there.
+    /// spring's force `k d` stays finite where its points meet, also when its length is a
+    /// parameter set to 0 (`L/ℓ` is selected away, not computed as 0/0); otherwise its
+    /// direction, and the force, are undefined there.
     fn spring(&mut self, a: Point, b: Point, [stiffness, length, damping]: [Id; 3]) {
         let (at_a, at_b) = (self.frames.world_point(a), self.frames.world_point(b));
         let d = self.frames.separation(a, b);
@@ -214,7 +257,11 @@ impl Work<'_> {
         let arena = &mut *self.frames.arena;
         let distance = arena.call(Func::Sqrt, squared);
         let rest = arena.mul(stiffness, length);
-        let shrink = arena.div(rest, distance);
+        let ratio = arena.div(rest, distance);
+        let zero = arena.zero();
+        let negative = arena.neg(rest);
+        let size = arena.select(zero, rest, rest, negative);
+        let shrink = arena.select(size, zero, zero, ratio);
         let elastic = arena.sub(stiffness, shrink);
         let damped = arena.mul(damping, approach);
         let viscous = arena.div(damped, squared);

@@ -58,6 +58,9 @@ pub struct Scene {
     /// The force solve, for a scene that computes forces: the generalised forces, the plan's
     /// stages in reverse, the reported reactions.
     pub forces: Option<reactions::Forces>,
+    /// For a scene that computes forces, two values per load that name the load making F
+    /// non-finite (`dynamics::load_witnesses`); empty otherwise.
+    pub load_witnesses: Vec<expr::Id>,
 }
 
 /// Parses, checks and differentiates a spec given as tokens.
@@ -111,11 +114,16 @@ impl Scene {
             plan.cache_final_reads(&mut model.arena, n, &reads);
             forces
         });
+        let load_witnesses = match forces {
+            Some(_) => dynamics::load_witnesses(&mut model),
+            None => Vec::new(),
+        };
         Scene {
             model,
             kinematics,
             plan,
             forces,
+            load_witnesses,
         }
     }
 }

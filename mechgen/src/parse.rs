@@ -821,6 +821,10 @@ fn unary(input: ParseStream) -> syn::Result<Expr> {
     power(input)
 }
 
+/// The largest integer exponent: differentiating `x^n` twice (for γ) lowers it by two, which
+/// must stay an `i32`. (Any exponent near this overflows or vanishes for every base but 1.)
+const MAX_INTEGER_POWER: i32 = 1 << 30;
+
 fn power(input: ParseStream) -> syn::Result<Expr> {
     let base = atom(input)?;
     if !input.peek(Token![^]) {
@@ -841,7 +845,23 @@ fn power(input: ParseStream) -> syn::Result<Expr> {
                 "an exponent takes no suffix: write `x^2`",
             ));
         }
-        let magnitude: i32 = exponent.base10_parse()?;
+        let magnitude = exponent
+            .base10_parse::<u64>()
+            .ok()
+            .and_then(|m| i32::try_from(m).ok())
+            .filter(|&m| m <= MAX_INTEGER_POWER)
+            .ok_or_else(|| {
+                syn::Error::new(
+                    exponent.span(),
+                    format!(
+                        "the integer exponent `{}` is too large: an integer power takes at most \
+                         {MAX_INTEGER_POWER} in magnitude; for a real power (of a positive \
+                         base) write the exponent as a decimal number, `x^{}.0`",
+                        exponent.base10_digits(),
+                        exponent.base10_digits(),
+                    ),
+                )
+            })?;
         let n = if negative { -magnitude } else { magnitude };
         return Ok(Expr {
             span,
@@ -996,6 +1016,25 @@ mod tests {
             "spline(t, (0, 1), (2, 3))"
         );
         assert_eq!(expr("180deg"), format!("{}", core::f64::consts::PI));
+    }
+
+    #[test]
+    fn integer_exponents_stay_differentiable() {
+        assert_eq!(expr("t^1073741824"), "(t^1073741824)");
+        assert_eq!(expr("t^-1073741824"), "(t^-1073741824)");
+        for huge in ["2147483648", "1073741825", "99999999999999999999999"] {
+            let Err(error) = syn::parse_str::<Expr>(&format!("t^{huge}")) else {
+                panic!("t^{huge} parsed");
+            };
+            let message = error.to_string();
+            assert!(
+                message.contains(&format!("the integer exponent `{huge}` is too large"))
+                    && message.contains(&format!("`x^{huge}.0`")),
+                "{message}"
+            );
+        }
+        // The way out it suggests is a real power.
+        assert_eq!(expr("t^2147483648.0"), "(t^2147483648)");
     }
 
     #[test]

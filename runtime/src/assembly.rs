@@ -88,6 +88,7 @@ where
                     time: t0,
                     reached,
                     steps,
+                    names: self.solver.mechanism().names(),
                 };
                 return Err(AssemblyError {
                     error,

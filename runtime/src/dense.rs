@@ -116,6 +116,9 @@ where
     fn marker_name(&self, index: usize) -> Option<&str> {
         self.inner.marker_name(index)
     }
+    fn names(&self) -> &'static crate::Names {
+        self.inner.names()
+    }
     fn coordinate_name(&self, index: usize) -> Option<&str> {
         self.inner.coordinate_name(index)
     }
@@ -207,6 +210,14 @@ where
     }
     fn reaction_name(&self, index: usize) -> Option<&str> {
         self.inner.reaction_name(index)
+    }
+    fn load_fault(
+        &self,
+        q: &Vector<M::Dim>,
+        qd: &Vector<M::Dim>,
+        t: f64,
+    ) -> Option<crate::Quantity> {
+        self.inner.load_fault(q, qd, t)
     }
 }
 

@@ -1,4 +1,5 @@
-//! Why a solve failed, with indices that [`SolveError::describe`] turns into scene names.
+//! Why a solve failed, naming the scene's equations, coordinates, branches and parameters
+//! from the [`Names`] the solver attaches to every error it returns.
 
 use core::fmt;
 
@@ -6,6 +7,7 @@ use nalgebra::DefaultAllocator;
 
 use crate::geometry::{GeometryFault, Requirement};
 use crate::mechanism::{Mechanism, Storage};
+use crate::names::Names;
 
 /// The quantity found to be NaN or infinite.
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
@@ -34,29 +36,63 @@ pub enum Quantity {
     Acceleration,
     /// A branch invariant of the scene (its index).
     Branch(usize),
-    /// The generalised applied and inertial forces F of the force solve (a load's expression,
-    /// a spring of zero length, an overflowing inertia force).
+    /// The generalised applied and inertial forces F of the force solve as a whole, when no
+    /// single load explains them ([`Quantity::LoadValue`] and [`Quantity::SpringEnds`] name
+    /// one): the masses' inertia or gravity overflowing.
     Load,
     /// The solved reactions (Lagrange multipliers) of the force solve.
     Reaction,
     /// A marker's value or rate (its index among the marker values).
     Marker(usize),
+    /// One load's force or moment (its index among the scene's loads): its expression or the
+    /// parameters it reads (a moment of 1e310, a division by zero).
+    LoadValue(usize),
+    /// A spring's force where its ends coincide (its index among the scene's loads): with a
+    /// non-zero free length or damping its direction, and so its force, is undefined there.
+    SpringEnds(usize),
+}
+
+/// The first load, among [`crate::Mechanism::load_fault`]'s witnesses (two values per load:
+/// the sum of its contributions to F, and for a spring the squared distance between its ends,
+/// else 1), whose contribution is not finite: [`Quantity::SpringEnds`] when the ends meet,
+/// [`Quantity::LoadValue`] otherwise. Generated scenes and the interpreter call it.
+pub fn first_load_fault(witnesses: &[f64]) -> Option<Quantity> {
+    witnesses
+        .chunks_exact(2)
+        .position(|w| !w[0].is_finite())
+        .map(|load| {
+            if witnesses.get(2 * load + 1).is_some_and(|&d| d == 0.0) {
+                Quantity::SpringEnds(load)
+            } else {
+                Quantity::LoadValue(load)
+            }
+        })
 }
 
 impl Quantity {
-    /// Writes the quantity, with `name` for a parameter or branch (its index otherwise).
-    fn write(self, f: &mut fmt::Formatter<'_>, name: Option<&str>) -> fmt::Result {
+    /// Writes the quantity, naming a parameter, branch or marker from `names` (its index
+    /// otherwise).
+    fn write(self, f: &mut fmt::Formatter<'_>, names: &dyn Lookup) -> fmt::Result {
         let text = match self {
-            Self::Parameter(index) | Self::Branch(index) | Self::Marker(index) => {
-                let what = match self {
-                    Self::Parameter(_) => "parameter",
-                    Self::Branch(_) => "branch invariant",
-                    _ => "marker value",
-                };
-                return match name {
-                    Some(name) => write!(f, "{what} `{name}`"),
-                    None => write!(f, "{what} #{index}"),
-                };
+            Self::Parameter(index) => {
+                f.write_str("parameter ")?;
+                return write_name(f, names.parameter(index), index);
+            }
+            Self::Branch(index) => {
+                f.write_str("branch invariant ")?;
+                return write_name(f, names.branch(index), index);
+            }
+            Self::Marker(index) => {
+                f.write_str("marker value ")?;
+                return write_name(f, names.marker(index), index);
+            }
+            Self::LoadValue(index) => {
+                f.write_str("the force or moment of load ")?;
+                return write_name(f, names.load(index), index);
+            }
+            Self::SpringEnds(index) => {
+                f.write_str("the force of spring ")?;
+                return write_name(f, names.load(index), index);
             }
             Self::Time => "the time",
             Self::Guess => "the positions q (initial guess)",
@@ -76,16 +112,18 @@ impl Quantity {
 
 impl fmt::Display for Quantity {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.write(f, None)
+        self.write(f, &Names::NONE)
     }
 }
 
 /// A failed position, velocity or acceleration solve: what went wrong, and when.
 ///
-/// Indices name equations, coordinates, branches and parameters of the scene; name them with
-/// [`SolveError::describe`] (the first equation and coordinate involved) or
-/// [`crate::Solver::describe`] (every one). A failed [`crate::Simulation::new`] hands its solver
-/// back in a [`crate::AssemblyError`], whose `Display` does this.
+/// Indices refer to equations, coordinates, branches and parameters of the scene; the solver
+/// attaches the scene's [`Names`] to every error it returns, so `Display` and `Debug` (what an
+/// error returned from `main` prints) name them, wherever the error goes.
+/// [`crate::Solver::describe`] adds every dependent equation and undetermined coordinate of
+/// the `Singular` it just returned. The error is `Copy` (the names are one `&'static`
+/// pointer) and allocation-free.
 ///
 /// ```
 /// # use mechgen_runtime::mechanism;
@@ -116,7 +154,7 @@ impl fmt::Display for Quantity {
 /// assert!(failure.to_string().contains("largest in equation `"));
 /// ```
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Clone, Copy, PartialEq)]
 pub enum SolveError {
     /// Newton–Raphson hit the iteration cap while still reducing the residual.
     NoConvergence {
@@ -129,6 +167,10 @@ pub enum SolveError {
         /// The equation with the largest scaled residual there: its joint's bodies are the
         /// ones whose guesses to move.
         equation: usize,
+        /// The scene's names, which `Display` and `Debug` use ([`Names::NONE`] until the
+        /// solver attaches its mechanism's, [`crate::Mechanism::names`]).
+        #[cfg_attr(feature = "serde", serde(skip))]
+        names: &'static Names,
     },
     /// The constraints cannot all be satisfied: the least-squares residual stopped decreasing
     /// well above the tolerance (links too short to close, a driver beyond the reachable range,
@@ -142,6 +184,10 @@ pub enum SolveError {
         residual: f64,
         /// The equation with the largest scaled residual there.
         equation: usize,
+        /// The scene's names, which `Display` and `Debug` use ([`Names::NONE`] until the
+        /// solver attaches its mechanism's, [`crate::Mechanism::names`]).
+        #[cfg_attr(feature = "serde", serde(skip))]
+        names: &'static Names,
     },
     /// Newton's corrections reached the rounding of the coordinates, but the residual stayed
     /// above [`crate::SolverOptions::acceptance_tolerance`]: a coordinate too large to resolve
@@ -156,6 +202,10 @@ pub enum SolveError {
         residual: f64,
         /// The equation with the largest scaled residual.
         equation: usize,
+        /// The scene's names, which `Display` and `Debug` use ([`Names::NONE`] until the
+        /// solver attaches its mechanism's, [`crate::Mechanism::names`]).
+        #[cfg_attr(feature = "serde", serde(skip))]
+        names: &'static Names,
     },
     /// Φ_q is singular or too ill-conditioned to trust at the solution: a toggle (dead-point)
     /// position, or redundant constraints.
@@ -173,6 +223,10 @@ pub enum SolveError {
         condition: f64,
         /// How many equations depend on the others (n − numerical rank).
         deficiency: usize,
+        /// The scene's names, which `Display` and `Debug` use ([`Names::NONE`] until the
+        /// solver attaches its mechanism's, [`crate::Mechanism::names`]).
+        #[cfg_attr(feature = "serde", serde(skip))]
+        names: &'static Names,
     },
     /// The solution has a branch invariant of the wrong sign: the mechanism would flip to
     /// another assembly branch (through a singular position, or by a too coarse time step).
@@ -183,6 +237,10 @@ pub enum SolveError {
         branch: usize,
         /// Its value (signed: positive on the declared branch).
         value: f64,
+        /// The scene's names, which `Display` and `Debug` use ([`Names::NONE`] until the
+        /// solver attaches its mechanism's, [`crate::Mechanism::names`]).
+        #[cfg_attr(feature = "serde", serde(skip))]
+        names: &'static Names,
     },
     /// An input or an evaluated quantity was NaN or infinite.
     NonFinite {
@@ -195,6 +253,10 @@ pub enum SolveError {
         /// driver whose expressions failed (`sqrt` of a negative number, a division by zero).
         /// `None` for inputs and for values no single equation produced.
         equation: Option<usize>,
+        /// The scene's names, which `Display` and `Debug` use ([`Names::NONE`] until the
+        /// solver attaches its mechanism's, [`crate::Mechanism::names`]).
+        #[cfg_attr(feature = "serde", serde(skip))]
+        names: &'static Names,
     },
     /// A geometric value computed from parameters (a body-fixed point, a distance, a ground
     /// pose, a prismatic axis) breaks its rule with the current parameter values: a distance
@@ -211,6 +273,10 @@ pub enum SolveError {
         value: f64,
         /// What it must be.
         requirement: Requirement,
+        /// The scene's names, which `Display` and `Debug` use ([`Names::NONE`] until the
+        /// solver attaches its mechanism's, [`crate::Mechanism::names`]).
+        #[cfg_attr(feature = "serde", serde(skip))]
+        names: &'static Names,
     },
     /// [`crate::Simulation::new`] followed the motion from t = 0 (where the `near` guesses
     /// describe the mechanism) towards the start time for
@@ -223,6 +289,10 @@ pub enum SolveError {
         reached: f64,
         /// Steps taken.
         steps: usize,
+        /// The scene's names, which `Display` and `Debug` use ([`Names::NONE`] until the
+        /// solver attaches its mechanism's, [`crate::Mechanism::names`]).
+        #[cfg_attr(feature = "serde", serde(skip))]
+        names: &'static Names,
     },
     /// A vector passed in does not have `dim()` entries (only possible with `Dyn` mechanisms).
     DimensionMismatch {
@@ -230,11 +300,15 @@ pub enum SolveError {
         expected: usize,
         /// The length passed in.
         found: usize,
+        /// The scene's names, which `Display` and `Debug` use ([`Names::NONE`] until the
+        /// solver attaches its mechanism's, [`crate::Mechanism::names`]).
+        #[cfg_attr(feature = "serde", serde(skip))]
+        names: &'static Names,
     },
 }
 
 impl GeometryFault {
-    /// The fault as the error of a solve at `time`.
+    /// The fault as the error of a solve at `time` (unnamed until the solver names it).
     pub fn at(self, time: f64) -> SolveError {
         SolveError::Geometry {
             time,
@@ -242,18 +316,75 @@ impl GeometryFault {
             parameter: self.parameter,
             value: self.value,
             requirement: self.requirement,
+            names: &Names::NONE,
         }
     }
 }
 
-/// Names for an error's indices, looked up in the mechanism (and the solver's diagnosis).
-#[derive(Default)]
-struct Names<'a> {
-    equation: Option<&'a str>,
-    coordinate: Option<&'a str>,
-    branch: Option<&'a str>,
-    parameter: Option<&'a str>,
-    marker: Option<&'a str>,
+/// Where an error's indices find their names: its own [`Names`], or a mechanism.
+trait Lookup {
+    fn equation(&self, index: usize) -> Option<&str>;
+    fn coordinate(&self, index: usize) -> Option<&str>;
+    fn parameter(&self, index: usize) -> Option<&str>;
+    fn branch(&self, index: usize) -> Option<&str>;
+    fn marker(&self, index: usize) -> Option<&str>;
+    fn load(&self, index: usize) -> Option<&str>;
+}
+
+impl Lookup for Names {
+    fn equation(&self, index: usize) -> Option<&str> {
+        Names::equation(self, index)
+    }
+    fn coordinate(&self, index: usize) -> Option<&str> {
+        Names::coordinate(self, index)
+    }
+    fn parameter(&self, index: usize) -> Option<&str> {
+        Names::parameter(self, index)
+    }
+    fn branch(&self, index: usize) -> Option<&str> {
+        Names::branch(self, index)
+    }
+    fn marker(&self, index: usize) -> Option<&str> {
+        Names::marker(self, index)
+    }
+    fn load(&self, index: usize) -> Option<&str> {
+        Names::load(self, index)
+    }
+}
+
+/// A mechanism's own names first, then those the error carries.
+struct FromMechanism<'a, M>(&'a M, &'static Names);
+
+impl<M: Mechanism> Lookup for FromMechanism<'_, M>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    fn equation(&self, index: usize) -> Option<&str> {
+        self.0.equation_name(index).or(self.1.equation(index))
+    }
+    fn coordinate(&self, index: usize) -> Option<&str> {
+        self.0.coordinate_name(index).or(self.1.coordinate(index))
+    }
+    fn parameter(&self, index: usize) -> Option<&str> {
+        self.0.parameter_name(index).or(self.1.parameter(index))
+    }
+    fn branch(&self, index: usize) -> Option<&str> {
+        self.0.branch_name(index).or(self.1.branch(index))
+    }
+    fn marker(&self, index: usize) -> Option<&str> {
+        self.0.marker_name(index).or(self.1.marker(index))
+    }
+    fn load(&self, index: usize) -> Option<&str> {
+        self.0.names().load(index).or(self.1.load(index))
+    }
+}
+
+/// Writes `` `name` `` when known, `#index` otherwise.
+fn write_name(f: &mut fmt::Formatter<'_>, name: Option<&str>, index: usize) -> fmt::Result {
+    match name {
+        Some(name) => write!(f, "`{name}`"),
+        None => write!(f, "#{index}"),
+    }
 }
 
 impl SolveError {
@@ -272,6 +403,54 @@ impl SolveError {
         }
     }
 
+    /// The name tables the error's `Display` and `Debug` use ([`Names::NONE`] when the error
+    /// did not come from a solver, or from a mechanism without names).
+    pub fn names(&self) -> &'static Names {
+        match *self {
+            Self::NoConvergence { names, .. }
+            | Self::NoAssembly { names, .. }
+            | Self::Unresolved { names, .. }
+            | Self::Singular { names, .. }
+            | Self::BranchFlip { names, .. }
+            | Self::NonFinite { names, .. }
+            | Self::Geometry { names, .. }
+            | Self::Unreachable { names, .. }
+            | Self::DimensionMismatch { names, .. } => names,
+        }
+    }
+
+    /// The error with `table` as its names (the solver does this for every error it returns).
+    #[must_use]
+    pub fn named(mut self, table: &'static Names) -> Self {
+        match &mut self {
+            Self::NoConvergence { names, .. }
+            | Self::NoAssembly { names, .. }
+            | Self::Unresolved { names, .. }
+            | Self::Singular { names, .. }
+            | Self::BranchFlip { names, .. }
+            | Self::NonFinite { names, .. }
+            | Self::Geometry { names, .. }
+            | Self::Unreachable { names, .. }
+            | Self::DimensionMismatch { names, .. } => *names = table,
+        }
+        self
+    }
+
+    /// The variant's name, which `Debug` leads with.
+    fn kind(&self) -> &'static str {
+        match self {
+            Self::NoConvergence { .. } => "NoConvergence",
+            Self::NoAssembly { .. } => "NoAssembly",
+            Self::Unresolved { .. } => "Unresolved",
+            Self::Singular { .. } => "Singular",
+            Self::BranchFlip { .. } => "BranchFlip",
+            Self::NonFinite { .. } => "NonFinite",
+            Self::Geometry { .. } => "Geometry",
+            Self::Unreachable { .. } => "Unreachable",
+            Self::DimensionMismatch { .. } => "DimensionMismatch",
+        }
+    }
+
     /// Whether a smaller time step may get past this failure (the simulation sub-steps on these):
     /// the Newton iteration lost its way, as opposed to a property of the configuration or of
     /// the input.
@@ -282,7 +461,8 @@ impl SolveError {
         )
     }
 
-    /// Displays the error with the mechanism's names instead of indices.
+    /// Displays the error with the mechanism's names (those the error carries where the
+    /// mechanism has none).
     pub fn describe<'a, M: Mechanism>(&'a self, mechanism: &'a M) -> Described<'a, M>
     where
         DefaultAllocator: Storage<M::Dim>,
@@ -295,22 +475,21 @@ impl SolveError {
         }
     }
 
-    fn write(&self, f: &mut fmt::Formatter<'_>, names: &Names<'_>) -> fmt::Result {
-        let equation = |f: &mut fmt::Formatter<'_>, index: usize| match names.equation {
-            Some(name) => write!(f, "`{name}`"),
-            None => write!(f, "#{index}"),
-        };
+    fn write(&self, f: &mut fmt::Formatter<'_>, names: &dyn Lookup) -> fmt::Result {
+        let equation =
+            |f: &mut fmt::Formatter<'_>, index: usize| write_name(f, names.equation(index), index);
         match *self {
             Self::NoConvergence {
                 time,
                 iterations,
                 residual,
                 equation: index,
+                ..
             } => {
                 write!(
                     f,
                     "no convergence at t = {time} after {iterations} Newton iterations \
-                     (‖Φ‖∞ = {residual:e}, largest in equation "
+                     (‖Φ‖∞ = {residual:.3e}, largest in equation "
                 )?;
                 equation(f, index)?;
                 f.write_str(
@@ -323,11 +502,12 @@ impl SolveError {
                 iterations,
                 residual,
                 equation: index,
+                ..
             } => {
                 write!(
                     f,
                     "the mechanism cannot assemble at t = {time}: after {iterations} iterations \
-                     the residual stopped at ‖Φ‖∞ = {residual:e}, largest in equation "
+                     the residual stopped at ‖Φ‖∞ = {residual:.3e}, largest in equation "
                 )?;
                 equation(f, index)?;
                 f.write_str("; check the link lengths and the driver values (can the loop close?)")
@@ -337,12 +517,13 @@ impl SolveError {
                 iterations,
                 residual,
                 equation: index,
+                ..
             } => {
                 write!(
                     f,
                     "the positions at t = {time} cannot be resolved in double precision: after \
                      {iterations} iterations the corrections reached the rounding of the \
-                     coordinates, but ‖Φ‖∞ = {residual:e} remains, largest in equation "
+                     coordinates, but ‖Φ‖∞ = {residual:.3e} remains, largest in equation "
                 )?;
                 equation(f, index)?;
                 f.write_str(
@@ -358,6 +539,7 @@ impl SolveError {
                 coordinate,
                 condition,
                 deficiency,
+                ..
             } => {
                 write!(
                     f,
@@ -367,25 +549,24 @@ impl SolveError {
                     if deficiency == 1 { "s" } else { "" },
                 )?;
                 equation(f, index)?;
-                match names.coordinate {
-                    Some(name) => write!(f, " leaves coordinate `{name}` undetermined")?,
-                    None => write!(f, " leaves coordinate #{coordinate} undetermined")?,
-                }
+                f.write_str(" leaves coordinate ")?;
+                write_name(f, names.coordinate(coordinate), coordinate)?;
                 f.write_str(
-                    " (a toggle/dead-point position, or redundant constraints: remove one of \
-                     the dependent equations' joints or drivers)",
+                    " undetermined (a toggle/dead-point position, or redundant constraints: \
+                     remove one of the dependent equations' joints or drivers)",
                 )
             }
             Self::BranchFlip {
                 time,
                 branch,
                 value,
+                ..
             } => {
                 write!(
                     f,
                     "the solution at t = {time} is on another assembly branch: "
                 )?;
-                Quantity::Branch(branch).write(f, names.branch)?;
+                Quantity::Branch(branch).write(f, names)?;
                 write!(
                     f,
                     " is {value:e} (should be positive); stepping, the motion passes through a \
@@ -397,9 +578,22 @@ impl SolveError {
                 time,
                 quantity,
                 equation: index,
+                ..
             } => {
-                quantity.write(f, names.parameter.or(names.branch).or(names.marker))?;
+                quantity.write(f, names)?;
                 write!(f, " became NaN or infinite at t = {time}")?;
+                match quantity {
+                    Quantity::SpringEnds(_) => f.write_str(
+                        ": its ends coincide, where a spring with a free length or damping has \
+                         no direction (give it free length 0 and no damping, or keep its ends \
+                         apart)",
+                    )?,
+                    Quantity::LoadValue(_) => f.write_str(
+                        " (check its expression and the parameters it reads for an overflow, a \
+                         division by zero or a square root of a negative number at this time)",
+                    )?,
+                    _ => {}
+                }
                 if let Some(index) = index {
                     f.write_str(", first in equation ")?;
                     equation(f, index)?;
@@ -416,11 +610,12 @@ impl SolveError {
                 parameter,
                 value,
                 requirement,
+                ..
             } => {
                 write!(f, "invalid geometry at t = {time}: a value of equation ")?;
                 equation(f, index)?;
                 write!(f, " is {value:e}, computed from ")?;
-                Quantity::Parameter(parameter).write(f, names.parameter)?;
+                Quantity::Parameter(parameter).write(f, names)?;
                 write!(
                     f,
                     "; it is {}: set the parameter to a value the mechanism can be built with",
@@ -431,25 +626,42 @@ impl SolveError {
                 time,
                 reached,
                 steps,
+                ..
             } => write!(
                 f,
                 "the start time t = {time} is out of reach: the `near` guesses describe the \
                  mechanism at t = 0, and {steps} steps of its motion from there reached only \
                  t = {reached}; start nearer t = 0"
             ),
-            Self::DimensionMismatch { expected, found } => {
-                write!(
-                    f,
-                    "vector of length {found} passed to a mechanism of dim {expected}"
-                )
+            Self::DimensionMismatch {
+                expected,
+                found,
+                names,
+            } => {
+                write!(f, "vector of length {found} passed to ")?;
+                if !names.mechanism.is_empty() {
+                    write!(f, "`{}`, ", names.mechanism)?;
+                }
+                write!(f, "a mechanism of {expected} coordinates (`dim()`)")
             }
         }
     }
 }
 
+/// The message with the scene's names (those the error carries).
 impl fmt::Display for SolveError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        self.write(f, &Names::default())
+        self.write(f, self.names())
+    }
+}
+
+/// The variant, then the named message: what `unwrap`, `expect` and an error returned from
+/// `main` print (`NoAssembly: the mechanism cannot assemble at t = 0: … equation
+/// `rocker_pin.x` …`).
+impl fmt::Debug for SolveError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: ", self.kind())?;
+        self.write(f, self.names())
     }
 }
 
@@ -470,49 +682,7 @@ where
     DefaultAllocator: Storage<M::Dim>,
 {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let m = self.mechanism;
-        let mut names = Names::default();
-        match *self.error {
-            SolveError::Singular {
-                equation,
-                coordinate,
-                ..
-            } => {
-                names.equation = m.equation_name(equation);
-                names.coordinate = m.coordinate_name(coordinate);
-            }
-            SolveError::NoAssembly { equation, .. }
-            | SolveError::NoConvergence { equation, .. }
-            | SolveError::Unresolved { equation, .. }
-            | SolveError::NonFinite {
-                equation: Some(equation),
-                ..
-            } => {
-                names.equation = m.equation_name(equation);
-            }
-            SolveError::BranchFlip { branch, .. } => names.branch = m.branch_name(branch),
-            SolveError::Geometry {
-                equation,
-                parameter,
-                ..
-            } => {
-                names.equation = m.equation_name(equation);
-                names.parameter = m.parameter_name(parameter);
-            }
-            SolveError::NonFinite {
-                quantity: Quantity::Parameter(index),
-                ..
-            } => names.parameter = m.parameter_name(index),
-            SolveError::NonFinite {
-                quantity: Quantity::Branch(index),
-                ..
-            } => names.branch = m.branch_name(index),
-            SolveError::NonFinite {
-                quantity: Quantity::Marker(index),
-                ..
-            } => names.marker = m.marker_name(index),
-            _ => {}
-        }
+        let names = FromMechanism(self.mechanism, self.error.names());
         self.error.write(f, &names)?;
         let lists = [
             ("dependent equations", self.dependent, true),
@@ -525,9 +695,9 @@ where
             write!(f, "\n  {what}:")?;
             for &index in indices {
                 let name = if equations {
-                    m.equation_name(index)
+                    names.equation(index)
                 } else {
-                    m.coordinate_name(index)
+                    names.coordinate(index)
                 };
                 match name {
                     Some(name) => write!(f, " {name}")?,
@@ -543,7 +713,176 @@ where
 mod tests {
     use super::*;
     use crate::pendulum::Pendulum;
+    use std::format;
     use std::string::ToString;
+    use std::vec::Vec;
+
+    static TABLE: Names = Names {
+        mechanism: "Linkage",
+        coordinates: &["crank.x", "crank.y", "crank.theta"],
+        equations: &["pivot.x", "pivot.y", "spin"],
+        parameters: &["omega", "length"],
+        branches: &["open"],
+        markers: &["tip.x"],
+        loads: &["gas"],
+    };
+
+    /// One error of every variant (and every quantity that has an index), each with the
+    /// names it must show.
+    fn every_error() -> Vec<(SolveError, &'static [&'static str])> {
+        let names = &Names::NONE;
+        let non_finite = |quantity, equation| SolveError::NonFinite {
+            time: 0.5,
+            quantity,
+            equation,
+            names,
+        };
+        std::vec![
+            (
+                SolveError::NoConvergence {
+                    time: 0.5,
+                    iterations: 25,
+                    residual: 1e-3,
+                    equation: 0,
+                    names,
+                },
+                &["`pivot.x`"][..],
+            ),
+            (
+                SolveError::Unreachable {
+                    time: 3.0,
+                    reached: 0.5,
+                    steps: 100_000,
+                    names,
+                },
+                &["t = 3", "t = 0.5", "100000 steps"],
+            ),
+            (
+                SolveError::NoAssembly {
+                    time: 0.5,
+                    iterations: 9,
+                    residual: 1.5,
+                    equation: 1,
+                    names,
+                },
+                &["`pivot.y`"],
+            ),
+            (
+                SolveError::Unresolved {
+                    time: 0.5,
+                    iterations: 9,
+                    residual: 1e-4,
+                    equation: 2,
+                    names,
+                },
+                &["`spin`"],
+            ),
+            (
+                SolveError::Singular {
+                    time: 0.5,
+                    equation: 2,
+                    coordinate: 1,
+                    condition: f64::INFINITY,
+                    deficiency: 1,
+                    names,
+                },
+                &["equation `spin` leaves coordinate `crank.y`"],
+            ),
+            (
+                SolveError::BranchFlip {
+                    time: 0.5,
+                    branch: 0,
+                    value: -1.0,
+                    names,
+                },
+                &["branch invariant `open`"],
+            ),
+            (
+                non_finite(Quantity::Parameter(1), None),
+                &["parameter `length`"]
+            ),
+            (
+                non_finite(Quantity::Branch(0), None),
+                &["branch invariant `open`"]
+            ),
+            (
+                non_finite(Quantity::Marker(0), None),
+                &["marker value `tip.x`"]
+            ),
+            (
+                non_finite(Quantity::LoadValue(0), None),
+                &["the force or moment of load `gas`"]
+            ),
+            (
+                non_finite(Quantity::SpringEnds(0), None),
+                &["the force of spring `gas`", "its ends coincide"]
+            ),
+            (
+                non_finite(Quantity::Phi, Some(0)),
+                &["first in equation `pivot.x`"]
+            ),
+            (
+                SolveError::Geometry {
+                    time: 0.5,
+                    equation: 0,
+                    parameter: 1,
+                    value: -5.0,
+                    requirement: Requirement::Distance,
+                    names,
+                },
+                &["equation `pivot.x`", "parameter `length`"],
+            ),
+            (
+                SolveError::DimensionMismatch {
+                    expected: 3,
+                    found: 2,
+                    names,
+                },
+                &["`Linkage`"],
+            ),
+        ]
+    }
+
+    #[test]
+    fn display_and_debug_name_everything_once_named() {
+        for (error, expected) in every_error() {
+            let named = error.named(&TABLE);
+            assert_eq!(named.names(), &TABLE);
+            let debug = format!("{named:?}");
+            for text in [named.to_string(), debug.clone()] {
+                for name in expected {
+                    assert!(text.contains(name), "`{name}` missing from: {text}");
+                }
+                // No bare index: every index the error holds is named.
+                assert!(!text.contains('#'), "{text}");
+            }
+            // Debug leads with the variant, so that `unwrap` and `main` say which one it is.
+            assert!(debug.starts_with(named.kind()), "{debug}");
+            if let Some(time) = named.time() {
+                assert!(debug.contains(&format!("t = {time}")), "{debug}");
+            }
+            // Unnamed, the same error shows indices.
+            assert!(
+                error.to_string().contains('#')
+                    || expected.is_empty()
+                    || expected[0].contains("Linkage")
+            );
+        }
+    }
+
+    #[test]
+    fn the_first_non_finite_load_is_named_with_its_cause() {
+        let nan = f64::NAN;
+        assert_eq!(first_load_fault(&[1.0, 1.0, 2.0, 0.0]), None);
+        assert_eq!(
+            first_load_fault(&[1.0, 1.0, nan, 0.0, nan, 1.0]),
+            Some(Quantity::SpringEnds(1))
+        );
+        assert_eq!(
+            first_load_fault(&[f64::INFINITY, 1.0, nan, 0.0]),
+            Some(Quantity::LoadValue(0))
+        );
+    }
 
     #[test]
     fn describe_replaces_indices_with_names() {
@@ -553,6 +892,7 @@ mod tests {
             coordinate: 1,
             condition: f64::INFINITY,
             deficiency: 1,
+            names: &Names::NONE,
         };
         let plain = error.to_string();
         assert!(plain.contains("1 equation depends"), "{plain}");
@@ -566,54 +906,42 @@ mod tests {
             "{named}"
         );
         assert_eq!(error.time(), Some(1.0));
+        assert!(!error.is_step_related());
     }
 
     #[test]
-    fn every_error_says_when_and_what() {
-        let pendulum = Pendulum::default();
-        let errors = [
-            SolveError::NoAssembly {
-                time: 0.5,
-                iterations: 9,
-                residual: 1.5,
-                equation: 0,
-            },
-            SolveError::BranchFlip {
-                time: 0.5,
-                branch: 0,
-                value: -1.0,
-            },
-            SolveError::NonFinite {
-                time: 0.5,
-                quantity: Quantity::Parameter(3),
-                equation: None,
-            },
-            SolveError::NonFinite {
-                time: 0.5,
-                quantity: Quantity::Phi,
-                equation: Some(2),
-            },
-            SolveError::NoConvergence {
-                time: 0.5,
-                iterations: 25,
-                residual: 1e-3,
-                equation: 0,
-            },
-        ];
-        for error in errors {
-            let text = error.describe(&pendulum).to_string();
-            assert!(text.contains("t = 0.5"), "{text}");
-            assert_eq!(error.time(), Some(0.5));
-        }
-        assert!(
-            errors[0]
-                .describe(&pendulum)
-                .to_string()
-                .contains("`pin.x`")
+    fn the_solver_names_the_errors_it_returns() {
+        use crate::{Dense, Simulation, Solver};
+        let mut solver = Solver::new(Dense::new(Pendulum::default()));
+        let short = nalgebra::Vector3::new(f64::NAN, 0.0, 0.0);
+        let error = solver.solve(0.0, &short).err().map(|e| format!("{e:?}"));
+        assert_eq!(
+            error.as_deref(),
+            Some("NonFinite: the positions q (initial guess) became NaN or infinite at t = 0")
         );
-        assert!(errors[2].to_string().contains("parameter #3"));
-        let phi = errors[3].describe(&pendulum).to_string();
-        assert!(phi.contains("first in equation `drive`"), "{phi}");
-        assert!(errors[0].is_step_related() && !errors[2].is_step_related());
+        let mut simulation =
+            match Simulation::new(Solver::new(Dense::new(Pendulum::default())), 0.0) {
+                Ok(simulation) => simulation,
+                Err(e) => panic!("{e}"),
+            };
+        let Err(error) = simulation.step_to(f64::NAN) else {
+            panic!("a NaN time must fail");
+        };
+        assert_eq!(error.names(), &crate::pendulum::NAMES);
+        let singular = Pendulum {
+            duplicate_pin: true,
+            ..Pendulum::default()
+        };
+        let guess = nalgebra::Vector3::new(2.0, 0.0, 0.0);
+        let Err(error) = Solver::new(Dense::new(singular)).solve(0.0, &guess) else {
+            panic!("a duplicated pin is singular");
+        };
+        let text = format!("{error:?}");
+        assert!(text.starts_with("Singular: "), "{text}");
+        assert!(
+            text.contains("equation `drive`") || text.contains("equation `pin.x`"),
+            "{text}"
+        );
+        assert!(!text.contains('#'), "{text}");
     }
 }

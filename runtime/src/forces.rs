@@ -18,6 +18,7 @@ use nalgebra::DefaultAllocator;
 use crate::block::{BlockSolve, Factors};
 use crate::error::{Quantity, SolveError};
 use crate::mechanism::{LengthScale, Storage, Vector};
+use crate::names::Names;
 use crate::position::Newton;
 use crate::solver::{SolverOptions, all_finite, check_finite, non_finite};
 use crate::structure::{Stage, Structured};
@@ -111,9 +112,10 @@ where
 }
 
 /// A non-finite multiplier most often comes from a non-finite F (a load's expression, a
-/// spring of zero length), which the stages' kernels fold in without a check of their own:
+/// spring whose ends meet), which the stages' kernels fold in without a check of their own:
 /// only on this failure path is F evaluated whole (into `scratch`), and the error then names
-/// it.
+/// the load and the cause ([`crate::Mechanism::load_fault`]), or F as a whole (the inertia of
+/// the masses).
 fn blame_loads<M: Structured>(
     m: &M,
     motion: &Motion<'_, M>,
@@ -130,7 +132,8 @@ where
     if all_finite(scratch.as_slice()) {
         error
     } else {
-        non_finite(motion.t, Quantity::Load)
+        let load = m.load_fault(motion.q, motion.qd, motion.t);
+        non_finite(motion.t, load.unwrap_or(Quantity::Load))
     }
 }
 
@@ -216,6 +219,7 @@ where
         time: t,
         quantity: Quantity::Reaction,
         equation: first,
+        names: &Names::NONE,
     }
 }
 

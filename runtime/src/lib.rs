@@ -10,7 +10,8 @@
 //! block's sparse factorisation fixed at generation time. [`Solver`] solves one instant
 //! ([`Solver::solve`]); [`Simulation`] steps through time with a warm-started predictor;
 //! [`Dense`] solves any mechanism as one dense block (the reference). Failures are
-//! [`SolveError`]s; [`Solver::describe`] names the equations and coordinates involved.
+//! [`SolveError`]s, which name the scene's equations, coordinates, branches and parameters
+//! ([`Names`]).
 //! [`State::write_csv_row`] writes results without a heap.
 //!
 //! # Quick start
@@ -65,6 +66,7 @@ mod lu;
 mod markers;
 pub mod math;
 mod mechanism;
+mod names;
 mod origin;
 #[cfg(test)]
 mod pendulum;
@@ -78,7 +80,7 @@ mod workspace;
 
 pub use assembly::{AssemblyError, GUESS_TIME, MAX_CONTINUATION_STEPS};
 pub use dense::{Dense, DenseBuffers};
-pub use error::{Described, Quantity, SolveError};
+pub use error::{Described, Quantity, SolveError, first_load_fault};
 pub use geometry::{GeometryFault, MAX_LENGTH, Requirement, check_geometry};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use markers::{
@@ -88,6 +90,7 @@ pub use mechanism::{
     Accelerations, Forces, MarkerStorage, Matrix, Mechanism, Outputs, ParameterError,
     ParameterNames, Storage, Unit, Vector, Velocities,
 };
+pub use names::Names;
 pub use reactions::{
     DistanceReaction, GearReaction, GroundLoad, PrismaticReaction, RackReaction, RevoluteReaction,
     SlotReaction, WeldReaction,

@@ -4,6 +4,7 @@ use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector};
 
 use crate::geometry::GeometryFault;
+use crate::names::Names;
 
 /// A column of coordinates or equation values (`Const<N>` for generated scenes: on the stack).
 pub type Vector<D> = OVector<f64, D>;
@@ -201,6 +202,14 @@ where
     /// The number of coordinates (= number of equations), as a value of the type-level dimension.
     fn dim(&self) -> Self::Dim;
 
+    /// The scene's name tables, which the solver attaches to every [`crate::SolveError`] it
+    /// returns so that the error names what failed. The default, [`Names::NONE`], leaves
+    /// errors with indices (the names methods below still serve
+    /// [`crate::SolveError::describe`]).
+    fn names(&self) -> &'static Names {
+        &Names::NONE
+    }
+
     /// Name of coordinate `index`, such as `"piston.x"`; `None` past the end.
     fn coordinate_name(&self, index: usize) -> Option<&str>;
 
@@ -370,6 +379,19 @@ where
     /// Name of marker value `index` (`tip.x`, `tip.y`, `tip.x_dot`, …, `swing.angle`, …); `None`
     /// past the end.
     fn marker_name(&self, _index: usize) -> Option<&str> {
+        None
+    }
+
+    /// On the force solve's failure path, with F not finite: the first load whose force or
+    /// moment is not, at the state `(q, q̇)` and `t` ([`crate::Quantity::LoadValue`], or
+    /// [`crate::Quantity::SpringEnds`] for a spring whose ends meet), so that the error names
+    /// it. The default finds none (F is then blamed as a whole: the masses' inertia).
+    fn load_fault(
+        &self,
+        _q: &Vector<Self::Dim>,
+        _qd: &Vector<Self::Dim>,
+        _t: f64,
+    ) -> Option<crate::Quantity> {
         None
     }
 

@@ -9,6 +9,7 @@ use nalgebra::DefaultAllocator;
 
 use crate::error::{Quantity, SolveError};
 use crate::mechanism::{Storage, Vector};
+use crate::names::Names;
 use crate::solver::Rates;
 use crate::structure::{Stage, Structured};
 
@@ -56,6 +57,7 @@ where
                     time,
                     quantity,
                     equation: equations.get(k).copied(),
+                    names: &Names::NONE,
                 };
             }
         }

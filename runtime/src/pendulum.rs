@@ -48,10 +48,21 @@ impl Pendulum {
 const COORDINATES: [&str; 3] = ["rod.x", "rod.y", "rod.theta"];
 const EQUATIONS: [&str; 3] = ["pin.x", "pin.y", "drive"];
 
+/// The pendulum's names, as a generated scene's `NAMES`.
+pub const NAMES: crate::Names = crate::Names {
+    mechanism: "Pendulum",
+    coordinates: &COORDINATES,
+    equations: &EQUATIONS,
+    ..crate::Names::NONE
+};
+
 impl Mechanism for Pendulum {
     type Dim = Const<3>;
     type Markers = [f64; 0];
 
+    fn names(&self) -> &'static crate::Names {
+        &NAMES
+    }
     fn dim(&self) -> Const<3> {
         Const
     }

@@ -27,6 +27,7 @@ use crate::block::{BlockSolve, Factors};
 use crate::error::{Quantity, SolveError};
 use crate::lu::{self, LuError};
 use crate::mechanism::{Storage, Vector};
+use crate::names::Names;
 use crate::solver::{SolverOptions, all_finite, non_finite};
 use crate::structure::Structured;
 use crate::workspace::Parts;
@@ -302,6 +303,7 @@ where
             time: self.t,
             quantity: Quantity::Phi,
             equation: row.and_then(|i| self.bs.block.equations.get(i).copied()),
+            names: &Names::NONE,
         })
     }
 
@@ -318,6 +320,7 @@ where
                 parts.newton.trial,
                 parts.factors.values,
             ),
+            names: &Names::NONE,
         }
     }
 
@@ -440,6 +443,7 @@ where
                 iterations,
                 residual,
                 equation,
+                names: &Names::NONE,
             }
         }
     }
@@ -463,6 +467,7 @@ where
             iterations,
             residual,
             equation,
+            names: &Names::NONE,
         }
     }
 
@@ -475,6 +480,7 @@ where
             iterations,
             residual,
             equation,
+            names: &Names::NONE,
         }
     }
 
@@ -525,6 +531,7 @@ where
                         coordinate: parts.col_order[0],
                         condition,
                         deficiency,
+                        names: &Names::NONE,
                     };
                 }
                 Err(_) => return self.non_finite_jacobian(q),
@@ -536,6 +543,7 @@ where
             coordinate: self.bs.block.coordinates.first().copied().unwrap_or(0),
             condition,
             deficiency: 0,
+            names: &Names::NONE,
         }
     }
 

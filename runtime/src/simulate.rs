@@ -192,6 +192,13 @@ where
     /// The [`SolveError`] of the solve at `t`, or of the sub-step that could not be shortened
     /// further (with its time); the simulation stays at the previous state.
     pub fn step_to(&mut self, t: f64) -> Result<&State<M>, SolveError> {
+        // The names are `'static`: naming a failure borrows nothing from the simulation.
+        let names = self.solver.mechanism().names();
+        self.step(t).map_err(|e| e.named(names))
+    }
+
+    /// [`Simulation::step_to`], with errors from the solver (named) and of its own (not yet).
+    fn step(&mut self, t: f64) -> Result<&State<M>, SolveError> {
         if !t.is_finite() {
             return Err(crate::solver::non_finite(t, Quantity::Time));
         }

@@ -13,6 +13,7 @@ use crate::lu::DEFAULT_PIVOT_TOLERANCE;
 use crate::mechanism::{
     Accelerations, LengthScale, Mechanism, Outputs, Storage, Vector, Velocities,
 };
+use crate::names::Names;
 use crate::origin;
 use crate::position::{Newton, Solved};
 use crate::state::State;
@@ -388,11 +389,16 @@ where
     /// # Errors
     /// As [`Solver::solve_into`].
     pub fn solve(&mut self, t: f64, q_guess: &Vector<M::Dim>) -> Result<State<M>, SolveError> {
-        self.check_len(q_guess)?;
+        self.check_len(q_guess).map_err(|e| self.named(e))?;
         let mut state = State::new(&self.mechanism);
         state.q.copy_from(q_guess);
         self.solve_into(t, &mut state)?;
         Ok(state)
+    }
+
+    /// `error` with the scene's names: every error a public method returns goes through here.
+    fn named(&self, error: SolveError) -> SolveError {
+        error.named(self.mechanism.names())
     }
 
     /// Solves positions starting from `state.q`, and the derivatives the scene provides, into
@@ -404,6 +410,11 @@ where
     /// # Errors
     /// Any [`SolveError`] of the position, velocity, acceleration or force solve.
     pub fn solve_into(&mut self, t: f64, state: &mut State<M>) -> Result<(), SolveError> {
+        self.solve_state(t, state).map_err(|e| self.named(e))
+    }
+
+    /// [`Solver::solve_into`], with unnamed errors.
+    fn solve_state(&mut self, t: f64, state: &mut State<M>) -> Result<(), SolveError> {
         self.check_len(&state.velocities)?;
         self.check_len(&state.accelerations)?;
         self.check_len(&state.reactions)?;
@@ -451,6 +462,7 @@ where
     ) -> Result<Convergence, SolveError> {
         let (mut qd, mut qdd) = (q.clone(), q.clone());
         self.solve_stages(t, q, &mut qd, &mut qdd, Rates::None, None)
+            .map_err(|e| self.named(e))
     }
 
     /// The stage sweep of [`Solver::solve_into`] and [`Solver::solve_position`], with a
@@ -668,6 +680,7 @@ where
                 coordinate: 0,
                 condition: f64::INFINITY,
                 deficiency: 0,
+                names: &Names::NONE,
             };
         };
         let bs = BlockSolve { m, stage: s, block };
@@ -780,6 +793,7 @@ where
             Err(SolveError::DimensionMismatch {
                 expected,
                 found: v.nrows(),
+                names: &Names::NONE,
             })
         }
     }
@@ -799,10 +813,11 @@ where
         t: f64,
         qd: &mut Vector<M::Dim>,
     ) -> Result<(), SolveError> {
-        self.check_inputs(t, q, Quantity::Guess)?;
-        self.check_len(qd)?;
         let mut qdd = q.clone();
-        self.rate_stages(t, q, qd, &mut qdd, Rates::Velocities)
+        self.check_inputs(t, q, Quantity::Guess)
+            .and_then(|()| self.check_len(qd))
+            .and_then(|()| self.rate_stages(t, q, qd, &mut qdd, Rates::Velocities))
+            .map_err(|e| self.named(e))
     }
 }
 
@@ -821,11 +836,12 @@ where
         t: f64,
         qdd: &mut Vector<M::Dim>,
     ) -> Result<(), SolveError> {
-        self.check_inputs(t, q, Quantity::Guess)?;
-        self.check_inputs(t, qd, Quantity::Velocity)?;
-        self.check_len(qdd)?;
         let mut velocities = qd.clone();
-        self.rate_stages(t, q, &mut velocities, qdd, Rates::Both)
+        self.check_inputs(t, q, Quantity::Guess)
+            .and_then(|()| self.check_inputs(t, qd, Quantity::Velocity))
+            .and_then(|()| self.check_len(qdd))
+            .and_then(|()| self.rate_stages(t, q, &mut velocities, qdd, Rates::Both))
+            .map_err(|e| self.named(e))
     }
 }
 
@@ -966,6 +982,7 @@ where
         time: t,
         quantity,
         equation: row.and_then(|i| bs.block.equations.get(i).copied()),
+        names: &Names::NONE,
     })
 }
 
@@ -1008,6 +1025,7 @@ where
                 time: t,
                 branch,
                 value,
+                names: &Names::NONE,
             });
         }
     }
@@ -1040,6 +1058,7 @@ pub(crate) fn non_finite(time: f64, quantity: Quantity) -> SolveError {
         time,
         quantity,
         equation: None,
+        names: &Names::NONE,
     }
 }
 
@@ -1294,6 +1313,7 @@ mod tests {
         let mismatch = SolveError::DimensionMismatch {
             expected: 3,
             found: 2,
+            names: &Names::NONE,
         };
         assert_eq!(solver.solve(0.7, &DVector::zeros(2)).err(), Some(mismatch));
         let mut short = state.clone();

@@ -307,6 +307,7 @@ fn a_start_time_beyond_the_step_budget_is_refused() {
         time,
         reached,
         steps,
+        ..
     } = failure.error
     else {
         panic!("{failure}");

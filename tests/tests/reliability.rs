@@ -84,6 +84,7 @@ fn a_huge_angle_passed_at_run_time_is_unresolved_not_accepted() {
         iterations: 1,
         residual: 95.0,
         equation: 8,
+        names: &mechgen_runtime::Names::NONE,
     };
     let text = error.describe(solver.mechanism()).to_string();
     assert!(

@@ -13,6 +13,7 @@ use syn::Ident;
 
 use super::Checker;
 use crate::expr::{Func, Func2, Id};
+use crate::resolution::{MIN_LENGTH, RESOLUTION};
 use crate::spec::{Expr, ExprKind};
 use crate::spline::SplineTable;
 
@@ -36,6 +37,70 @@ const FUNCTIONS: [&str; 16] = [
     "spline(x, (x0, y0), (x1, y1), …)",
 ];
 
+/// Functions of other languages, with what to write instead.
+const ALIASES: [(&str, &str); 20] = [
+    (
+        "atan",
+        "`atan2(y, x)` (the angle of (x, y) in all four quadrants; `atan(u)` is `atan2(u, 1)`)",
+    ),
+    (
+        "arctan",
+        "`atan2(y, x)` (the angle of (x, y) in all four quadrants; `atan(u)` is `atan2(u, 1)`)",
+    ),
+    ("atan2f", "`atan2(y, x)`"),
+    ("pow", "the power operator: `a^b` for `pow(a, b)`"),
+    ("powf", "the power operator: `a^b` for `powf(a, b)`"),
+    ("powi", "the power operator: `a^n` for `powi(a, n)`"),
+    ("power", "the power operator: `a^b` for `power(a, b)`"),
+    ("sqr", "`x^2`"),
+    ("cbrt", "`x^(1 / 3)` (for positive x)"),
+    ("log", "`ln(x)` (the natural logarithm)"),
+    ("log10", "`ln(x) / ln(10)`"),
+    ("arcsin", "`asin(x)`"),
+    ("arccos", "`acos(x)`"),
+    ("fabs", "`abs(x)`"),
+    ("hypot", "`sqrt(x^2 + y^2)`"),
+    ("sinh", "`(exp(x) - exp(-x)) / 2`"),
+    ("cosh", "`(exp(x) + exp(-x)) / 2`"),
+    ("tanh", "`(exp(x) - exp(-x)) / (exp(x) + exp(-x))`"),
+    (
+        "rad",
+        "`x * pi / 180`, or `deg(x)`, or a literal in degrees such as `30deg`",
+    ),
+    (
+        "radians",
+        "`deg(x)` (x in degrees, as radians), or a literal such as `30deg`",
+    ),
+];
+
+/// How to fix a call of the unknown function `name`, with the separator before the list of
+/// functions: another language's name for a function of the spec language, or the nearest
+/// name by edit distance.
+fn suggestion(name: &str) -> String {
+    if let Some((_, fix)) = ALIASES.iter().find(|(alias, _)| *alias == name) {
+        return format!("; write {fix};");
+    }
+    let names = FUNCTIONS.iter().filter_map(|u| u.split('(').next());
+    let usage = super::did_you_mean(name, names).and_then(|nearest| {
+        FUNCTIONS
+            .iter()
+            .find(|u| u.split('(').next() == Some(nearest))
+    });
+    match usage {
+        Some(usage) => format!("; did you mean `{usage}`?"),
+        None => ";".to_owned(),
+    }
+}
+
+/// A number as a user would write it: plain near 1, in exponent form far from it.
+fn number(v: f64) -> String {
+    if v == 0.0 || (1e-4..1e15).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
 impl Checker {
     /// `f(args…)`, lowered.
     pub(super) fn call(
@@ -55,7 +120,8 @@ impl Checker {
             self.errors.push(
                 f.span(),
                 format!(
-                    "unknown function `{f}`; supported functions are {}",
+                    "unknown function `{f}`{} supported functions are {}",
+                    suggestion(&name),
                     list.join(", ")
                 ),
             );
@@ -136,6 +202,48 @@ impl Checker {
     }
 
     /// A rise from 0 to 1 as `u` goes from 0 to 1: 0 before, `rise` between, 1 after.
+    /// Whether every spacing of increasing knots is one double precision resolves, reporting
+    /// the first that is not at the later knot: at least [`MIN_LENGTH`] (a spline's slopes
+    /// and curvatures are its values over the spacing and its square, which a smaller one
+    /// overflows, as `(0, 0), (1e-300, 1)` does: a NaN at run time) and at least
+    /// [`RESOLUTION`] of the knots' magnitude (closer knots differ only in rounding).
+    /// Knots out of order are left to the table's own message.
+    fn resolved_knots(&mut self, knots: &[f64], spans: &[Span]) -> bool {
+        for k in 1..knots.len().min(spans.len()) {
+            let (a, b) = (knots[k - 1], knots[k]);
+            let spacing = b - a;
+            if spacing <= 0.0 || !spacing.is_finite() {
+                continue;
+            }
+            let size = a.abs().max(b.abs());
+            let rule = if spacing < MIN_LENGTH {
+                format!(
+                    "at least {MIN_LENGTH:e} (the spline's slopes and curvatures, its values \
+                         over the spacing and its square, would overflow)"
+                )
+            } else if spacing < RESOLUTION * size {
+                format!(
+                    "at least {RESOLUTION:e} of the x values' size (closer knots differ only \
+                         in rounding)"
+                )
+            } else {
+                continue;
+            };
+            self.errors.push(
+                spans[k],
+                format!(
+                    "a spline's x values {} and {} are {} apart; knots must be spaced {rule}: \
+                     merge the two points or space them further apart",
+                    number(a),
+                    number(b),
+                    number(spacing),
+                ),
+            );
+            return false;
+        }
+        true
+    }
+
     fn clamped(&mut self, u: Id, rise: Id) -> Id {
         let (zero, one) = (self.arena.zero(), self.arena.one());
         let upper = self.arena.select(u, one, rise, one);
@@ -174,6 +282,7 @@ impl Checker {
         };
         let x = self.lower_with(x, allow_params, allow_t);
         let mut knots = Vec::with_capacity(points.len());
+        let mut knot_spans = Vec::with_capacity(points.len());
         let mut values = Vec::with_capacity(points.len());
         for point in points {
             let ExprKind::Tuple(pair) = &point.kind else {
@@ -193,7 +302,10 @@ impl Checker {
             // Parameters are let through here so that the message below names the rule.
             let knot_id = self.lower_with(knot, true, false);
             match self.arena.as_const(knot_id) {
-                Some(k) => knots.push(k),
+                Some(k) => {
+                    knots.push(k);
+                    knot_spans.push(knot.span);
+                }
                 None => {
                     self.errors.push(
                         knot.span,
@@ -204,6 +316,9 @@ impl Checker {
                 }
             }
             values.push(self.lower_with(value, allow_params, allow_t));
+        }
+        if !self.resolved_knots(&knots, &knot_spans) {
+            return self.arena.zero();
         }
         // The constant values in one table, each other value weighting its cardinal spline.
         let constants: Vec<f64> = values

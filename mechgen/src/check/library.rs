@@ -308,21 +308,50 @@ impl Checker {
         Some((pa, pb))
     }
 
-    /// `along (ux, uy)` as a unit vector; the zero vector is an error.
+    /// `along (ux, uy)` as a unit vector; the zero vector is an error. The length is never
+    /// formed as `ux² + uy²`, whose square underflows to zero for `(0, 1e-170)` (which is a
+    /// direction) and overflows for `(0, 1e160)`: constants are divided by their `hypot`, and a
+    /// direction in parameters is first scaled by its larger magnitude.
     fn unit_axis(&mut self, axis: &[Expr; 2], span: Span) -> Option<[Id; 2]> {
         let ux = self.geometry(&axis[0]);
         let uy = self.geometry(&axis[1]);
-        let (ux2, uy2) = (self.arena.powi(ux, 2), self.arena.powi(uy, 2));
-        let norm2 = self.arena.add(ux2, uy2);
-        if self.arena.as_const(norm2) == Some(0.0) {
-            self.errors.push(
+        let zero_vector = |cx: &mut Self| {
+            cx.errors.push(
                 span,
                 "the axis is the zero vector; give a direction such as `along (1, 0)`",
             );
-            return None;
+            None
+        };
+        if !self.arena.simplifies() {
+            // The naive baseline (`CodegenOptions::naive`) keeps the textbook formula.
+            let (ux2, uy2) = (self.arena.powi(ux, 2), self.arena.powi(uy, 2));
+            let norm2 = self.arena.add(ux2, uy2);
+            let norm = self.arena.call(Func::Sqrt, norm2);
+            return Some([self.arena.div(ux, norm), self.arena.div(uy, norm)]);
         }
+        if let (Some(x), Some(y)) = (self.arena.as_const(ux), self.arena.as_const(uy)) {
+            let length = x.hypot(y);
+            if length == 0.0 {
+                return zero_vector(self);
+            }
+            // A non-finite component folds to NaN here and is reported with the geometry.
+            let unit = [x / length, y / length].map(|v| self.arena.constant(v));
+            return Some(unit);
+        }
+        let abs = |arena: &mut crate::expr::Arena, v: Id| {
+            let (zero, negative) = (arena.zero(), arena.neg(v));
+            arena.select(zero, v, v, negative)
+        };
+        let (ax, ay) = (abs(&mut self.arena, ux), abs(&mut self.arena, uy));
+        let scale = self.arena.select(ay, ax, ax, ay);
+        if self.arena.as_const(scale) == Some(0.0) {
+            return zero_vector(self);
+        }
+        let (sx, sy) = (self.arena.div(ux, scale), self.arena.div(uy, scale));
+        let (sx2, sy2) = (self.arena.powi(sx, 2), self.arena.powi(sy, 2));
+        let norm2 = self.arena.add(sx2, sy2);
         let norm = self.arena.call(Func::Sqrt, norm2);
-        Some([self.arena.div(ux, norm), self.arena.div(uy, norm)])
+        Some([self.arena.div(sx, norm), self.arena.div(sy, norm)])
     }
 
     /// A distance joint's length: neither zero nor negative when constant.

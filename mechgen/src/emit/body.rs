@@ -105,6 +105,8 @@ pub(super) struct Context<'a> {
     pub forces: Option<&'a crate::reactions::Forces>,
     /// The markers' values (from the kinematics).
     pub markers: &'a [Id],
+    /// Two values per load naming the one that makes F non-finite (`Scene::load_witnesses`).
+    pub load_witnesses: &'a [Id],
     pub options: &'a CodegenOptions,
     /// Helper functions of split bodies, emitted in an inherent `impl` block.
     pub helpers: RefCell<Vec<TokenStream>>,

@@ -71,11 +71,40 @@ impl Context<'_> {
                 }
             }
         };
+        let load_fault = self.load_fault();
         quote! {
             #generalized
             #reactions
             fn reaction_name(&self, index: usize) -> ::core::option::Option<&str> {
                 Self::REACTIONS.get(index).copied()
+            }
+            #load_fault
+        }
+    }
+
+    /// `load_fault`, for a scene with loads: their witnesses (`dynamics::load_witnesses`) into
+    /// a local array, then the first load whose contribution is not finite. Only the force
+    /// solve's failure path calls it.
+    fn load_fault(&self) -> TokenStream {
+        let witnesses = self.load_witnesses;
+        if witnesses.is_empty() {
+            return TokenStream::new();
+        }
+        let vector = self.vector_type();
+        let k = idx(witnesses.len());
+        let outputs = super::vector_outputs(witnesses, &quote!(out));
+        let f = self.function(&outputs, TokenStream::new(), &computed());
+        let (body, q, qd, t) = (f.body, &f.args.q, &f.args.qd, &f.args.t);
+        quote! {
+            fn load_fault(
+                &self,
+                #q: &#vector,
+                #qd: &#vector,
+                #t: f64,
+            ) -> ::core::option::Option<::mechgen_runtime::Quantity> {
+                let mut out = [0.0_f64; #k];
+                #body
+                ::mechgen_runtime::first_load_fault(&out)
             }
         }
     }

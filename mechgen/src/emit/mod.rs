@@ -62,6 +62,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
         kinematics_branches: &scene.kinematics.branches,
         forces: scene.forces.as_ref(),
         markers: &scene.kinematics.markers,
+        load_witnesses: &scene.load_witnesses,
         options,
         helpers: RefCell::new(Vec::new()),
     };
@@ -195,6 +196,7 @@ impl Context<'_> {
         let reaction_names = self.forces.map(|_| self.reaction_names());
         let splines = self.spline_tables();
         let marker_names = self.marker_names();
+        let names = self.names_table();
         let coordinate_doc = format!(
             " Coordinate names in q order ({n} = 3 × {} bodies).",
             model.bodies.len()
@@ -224,8 +226,38 @@ impl Context<'_> {
                 #reaction_names
                 #splines
                 #marker_names
+                #names
                 #(#coordinate_consts)*
             }
+        }
+    }
+
+    /// `NAMES`: the tables above in one `'static` value, which the solver attaches to every
+    /// error so that it names what failed; the scene's loads are listed here only.
+    fn names_table(&self) -> TokenStream {
+        let model = self.model;
+        let name = model.name.to_string();
+        let table = |present: bool, konst: TokenStream| {
+            if present {
+                quote!(&Self::#konst)
+            } else {
+                quote!(&[])
+            }
+        };
+        let branches = table(!model.branches.is_empty(), quote!(BRANCHES));
+        let markers = table(!model.marker_names().is_empty(), quote!(MARKERS));
+        let loads = model.loads.iter().map(|l| l.name.as_str());
+        quote! {
+            /// Every name above, for errors (`mechgen_runtime::Mechanism::names`).
+            pub const NAMES: ::mechgen_runtime::Names = ::mechgen_runtime::Names {
+                mechanism: #name,
+                coordinates: &Self::COORDINATES,
+                equations: &Self::EQUATIONS,
+                parameters: &Self::PARAMETERS,
+                branches: #branches,
+                markers: #markers,
+                loads: &[#(#loads),*],
+            };
         }
     }
 
@@ -284,6 +316,10 @@ impl Context<'_> {
 
                 fn dim(&self) -> Self::Dim {
                     ::mechgen_runtime::nalgebra::Const::<#n_lit>
+                }
+
+                fn names(&self) -> &'static ::mechgen_runtime::Names {
+                    &Self::NAMES
                 }
 
                 fn coordinate_name(&self, index: usize) -> ::core::option::Option<&str> {

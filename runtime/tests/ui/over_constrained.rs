@@ -1,5 +1,5 @@
-//! Joints that remove more freedom than the bodies have (a pendulum pinned twice); the error
-//! points at the mechanism's name.
+//! Joints that remove more freedom than the bodies have (a pendulum pinned twice, at two
+//! points): neither pin repeats the other, so the error points at the last joint involved.
 use mechgen_runtime::mechanism;
 
 mechanism! {

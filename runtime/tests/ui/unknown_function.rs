@@ -1,4 +1,5 @@
-//! Unknown function (`cosh`); the error points at `cosh` and lists the supported functions.
+//! Unknown function (`cosh`); the error points at `cosh`, writes it with `exp` and lists the
+//! supported functions.
 use mechgen_runtime::mechanism;
 
 mechanism! {
