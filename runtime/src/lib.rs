@@ -54,6 +54,7 @@ extern crate alloc;
 #[cfg(test)]
 extern crate std;
 
+mod acceptance;
 mod assembly;
 mod block;
 mod crossing;

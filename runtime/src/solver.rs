@@ -6,6 +6,7 @@
 
 use nalgebra::{DefaultAllocator, Dim};
 
+use crate::acceptance::{self, Rounding};
 use crate::block::{BlockSolve, Factors};
 use crate::error::{Described, Quantity, SolveError};
 use crate::forces;
@@ -136,7 +137,10 @@ pub struct Convergence {
     pub iterations: usize,
     /// Largest ‖Φ_b‖∞ (unscaled) of the blocks at their last evaluation: at the returned
     /// positions, or, where the last correction was of round-off size, just before it.
-    /// Explicit assignments satisfy their equations to rounding.
+    /// Explicit assignments satisfy their equations to the rounding of the coordinates they
+    /// combine; where that rounding could reach `acceptance_tolerance` (coordinates beyond
+    /// ~4e4 scene lengths or radians), their residuals at the returned positions are
+    /// evaluated and included here.
     pub residual: f64,
     /// Largest condition estimate κ₁ of the scaled block Jacobians at the solution (1 without
     /// blocks; NaN if switched off).
@@ -481,13 +485,17 @@ where
         } = self;
         let mut parts = workspace.parts();
         let mut total = Convergence::start(options.estimate_condition);
+        // A looser residual tolerance asked for loosens acceptance with it (as in `position`).
+        let acceptance = options.acceptance_tolerance.max(options.residual_tolerance);
+        let mut rounding = Rounding::new(acceptance);
         // How much of the force solve's archive the blocks have filled.
         let mut archived = 0;
         for s in 0..m.stage_count() {
             *reached = s;
             match m.stage(s) {
-                Some(Stage::Explicit { .. }) => {
+                Some(Stage::Explicit { coordinates, .. }) => {
                     m.assign_positions(s, q, parts.trig, t);
+                    rounding.explicit(m, coordinates, q, length);
                     m.fill_trig(s, q, parts.trig);
                     assign_rates(m, s, q, parts.trig, qd, qdd, t, rates);
                 }
@@ -499,6 +507,7 @@ where
                         .solve(q, rates != Rates::None)
                         .map_err(|e| record(e, m, s, newton.parts, diagnosed))?;
                     total.add(&solved, (newton.fallbacks, newton.evaluations));
+                    rounding.block::<M>(block.coordinates, newton.parts.scales.inverse_cols, q);
                     m.fill_trig(s, q, newton.parts.trig);
                     block_rates(
                         &newton.bs,
@@ -523,6 +532,10 @@ where
         // (or earlier, as the non-finite Φ or rate of a block that reads it).
         *reached = m.stage_count();
         check_finite(q, t, Quantity::Phi)?;
+        if rounding.pending() {
+            let explicit = acceptance::check_explicit(m, q, t, length, acceptance)?;
+            total.residual = total.residual.max(explicit);
+        }
         check_rates(qd, qdd, t, rates)?;
         check_branches(m, q, parts.trig, t)?;
         if let Some(Extras { reactions, markers }) = extras {
