@@ -11,15 +11,16 @@ use std::cell::{Cell, RefCell};
 
 use mechgen::Scene;
 use mechgen::factor::Factorization;
-use mechgen::geometry;
 use mechgen::interpret::{Inputs, Tape};
 use mechgen::kinematics::LengthScale;
 use mechgen::reactions::ForceStage;
 use mechgen::structure::{self, Phase, Plan};
+use mechgen::{geometry, physics};
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{
     Accelerations, Block, Forces, GeometryFault, Matrix, Mechanism, Outputs, ParameterError,
-    Pattern, Requirement, Stage, Structured, Unit, VecBuffers, Vector, Velocities,
+    Pattern, PhysicsFault, Requirement, Stage, Structured, Subject, Unit, VecBuffers, Vector,
+    Velocities, check_physics,
 };
 
 /// A scene whose kinematics are interpreted rather than generated.
@@ -55,6 +56,11 @@ pub struct Interpreted {
     /// The geometry written in parameters: each value's rule, and one tape for the values.
     geometry: Vec<geometry::Check>,
     geometry_values: Tape,
+    /// The mass properties and load constants written in parameters, likewise, and the
+    /// loads' names they report.
+    physics: Vec<physics::Check>,
+    physics_values: Tape,
+    load_names: Vec<String>,
     branch_names: Vec<String>,
     /// One tape per branch invariant (its signed value), and the same reading the trig cache.
     branches: Vec<Tape>,
@@ -259,6 +265,8 @@ impl Interpreted {
         let lengths = Tape::new(arena, &kin.length_scale.dependent);
         let geometry_ids: Vec<_> = kin.geometry.iter().map(|c| c.value).collect();
         let geometry_values = Tape::new(arena, &geometry_ids);
+        let physics_ids: Vec<_> = kin.physics.iter().map(|c| c.value).collect();
+        let physics_values = Tape::new(arena, &physics_ids);
         let branches: Vec<Tape> = kin
             .branches
             .iter()
@@ -301,7 +309,7 @@ impl Interpreted {
             .chain(&gamma)
             .chain(forces.iter().flat_map(|(f, r)| [f, r]))
             .chain([&markers.0, &markers.1])
-            .chain([&lengths, &geometry_values])
+            .chain([&lengths, &geometry_values, &physics_values])
             .chain(&branches)
             .chain(&cached_branches)
             .chain(stages.iter().flat_map(PlanStage::tapes))
@@ -313,6 +321,7 @@ impl Interpreted {
             .max(model.dim())
             .max(kin.length_scale.dependent.len())
             .max(kin.geometry.len())
+            .max(kin.physics.len())
             .max(plan.largest_block() + plan.largest_slots())
             .max(kin.markers.len())
             .max(1);
@@ -347,6 +356,9 @@ impl Interpreted {
             lengths,
             geometry: kin.geometry.clone(),
             geometry_values,
+            physics: kin.physics.clone(),
+            physics_values,
+            load_names: model.loads.iter().map(|l| l.name.clone()).collect(),
             branch_names: model.branches.iter().map(|b| b.name.clone()).collect(),
             branches,
             cached_branches,
@@ -546,6 +558,27 @@ impl Mechanism for Interpreted {
             });
         });
         result
+    }
+
+    fn check_physics(&self) -> Result<(), PhysicsFault> {
+        let mut result = Ok(());
+        if self.physics.is_empty() {
+            return result;
+        }
+        self.run(&self.physics_values, self.inputs(&[], &[], 0.0), |v| {
+            result = self.physics.iter().zip(v).try_for_each(|(c, &value)| {
+                let subject = match c.subject {
+                    physics::Subject::Body(b) => Subject::Body(b),
+                    physics::Subject::Load(l) => Subject::Load(l),
+                };
+                check_physics(value, requirement(c.requirement), subject, c.parameter)
+            });
+        });
+        result
+    }
+
+    fn load_name(&self, index: usize) -> Option<&str> {
+        self.load_names.get(index).map(String::as_str)
     }
 
     fn branch_count(&self) -> usize {
@@ -978,5 +1011,11 @@ fn requirement(requirement: geometry::Requirement) -> Requirement {
         geometry::Requirement::Distance => Requirement::Distance,
         geometry::Requirement::Angle => Requirement::Angle,
         geometry::Requirement::Axis => Requirement::Axis,
+        geometry::Requirement::Ratio => Requirement::Ratio,
+        geometry::Requirement::Mass => Requirement::Mass,
+        geometry::Requirement::Inertia => Requirement::Inertia,
+        geometry::Requirement::Stiffness => Requirement::Stiffness,
+        geometry::Requirement::FreeLength => Requirement::FreeLength,
+        geometry::Requirement::Damping => Requirement::Damping,
     }
 }

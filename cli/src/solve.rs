@@ -116,7 +116,7 @@ fn assembly_hint(error: &SolveError) -> &'static str {
             "a coordinate is too large to resolve: give `near` angles within a turn and \
              positions near the scene's size, and check parameters that set huge values"
         }
-        SolveError::Geometry { .. } => GEOMETRY_HINT,
+        SolveError::Geometry { .. } | SolveError::Physics { .. } => GEOMETRY_HINT,
         _ => "check the parameter values and the `near` guesses for divisions by zero",
     }
 }
@@ -143,7 +143,7 @@ fn step_hint(error: &SolveError) -> &'static str {
             "a coordinate has grown too large to resolve (a driven angle after very many \
              turns?): start the run at a smaller time, or drive the angle with a periodic law"
         }
-        SolveError::Geometry { .. } => GEOMETRY_HINT,
+        SolveError::Geometry { .. } | SolveError::Physics { .. } => GEOMETRY_HINT,
         _ => "a value became NaN or infinite: check the parameter values and the time range",
     }
 }

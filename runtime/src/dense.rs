@@ -150,6 +150,12 @@ where
     fn check_geometry(&self) -> Result<(), crate::GeometryFault> {
         self.inner.check_geometry()
     }
+    fn check_physics(&self) -> Result<(), crate::PhysicsFault> {
+        self.inner.check_physics()
+    }
+    fn load_name(&self, index: usize) -> Option<&str> {
+        self.inner.load_name(index)
+    }
     fn branch_count(&self) -> usize {
         self.inner.branch_count()
     }

@@ -6,6 +6,7 @@ use nalgebra::DefaultAllocator;
 
 use crate::geometry::{GeometryFault, Requirement};
 use crate::mechanism::{Mechanism, Storage};
+use crate::physics::Subject;
 
 /// The quantity found to be NaN or infinite.
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
@@ -209,6 +210,22 @@ pub enum SolveError {
         /// What it must be.
         requirement: Requirement,
     },
+    /// A mass property or load constant computed from parameters (a mass, an inertia, a
+    /// centre of mass, a spring's stiffness, free length or damping, a load's point) breaks
+    /// the rule constants obey at compile time, with the current parameter values: a negative
+    /// mass or stiffness. See [`crate::Mechanism::check_physics`].
+    Physics {
+        /// Time of the solve.
+        time: f64,
+        /// The body or load the value belongs to.
+        subject: Subject,
+        /// The first parameter (by index) the value is computed from.
+        parameter: usize,
+        /// The value.
+        value: f64,
+        /// What it must be.
+        requirement: Requirement,
+    },
     /// A vector passed in does not have `dim()` entries (only possible with `Dyn` mechanisms).
     DimensionMismatch {
         /// The mechanism's `dim()`.
@@ -239,6 +256,8 @@ struct Names<'a> {
     branch: Option<&'a str>,
     parameter: Option<&'a str>,
     marker: Option<&'a str>,
+    /// The body or load of a [`SolveError::Physics`].
+    subject: Option<&'a str>,
 }
 
 impl SolveError {
@@ -251,7 +270,8 @@ impl SolveError {
             | Self::Singular { time, .. }
             | Self::BranchFlip { time, .. }
             | Self::NonFinite { time, .. }
-            | Self::Geometry { time, .. } => Some(time),
+            | Self::Geometry { time, .. }
+            | Self::Physics { time, .. } => Some(time),
             Self::DimensionMismatch { .. } => None,
         }
     }
@@ -403,6 +423,28 @@ impl SolveError {
                     requirement.describe()
                 )
             }
+            Self::Physics {
+                time,
+                subject,
+                parameter,
+                value,
+                requirement,
+            } => {
+                write!(f, "invalid physics at t = {time}: a value of ")?;
+                match (subject, names.subject) {
+                    (Subject::Body(_), Some(name)) => write!(f, "body `{name}`")?,
+                    (Subject::Body(index), None) => write!(f, "body #{index}")?,
+                    (Subject::Load(_), Some(name)) => write!(f, "load `{name}`")?,
+                    (Subject::Load(index), None) => write!(f, "load #{index}")?,
+                }
+                write!(f, " is {value:e}, computed from ")?;
+                Quantity::Parameter(parameter).write(f, names.parameter)?;
+                write!(
+                    f,
+                    "; it is {}: set the parameter to a physical value",
+                    requirement.describe()
+                )
+            }
             Self::DimensionMismatch { expected, found } => {
                 write!(
                     f,
@@ -462,6 +504,18 @@ where
                 ..
             } => {
                 names.equation = m.equation_name(equation);
+                names.parameter = m.parameter_name(parameter);
+            }
+            SolveError::Physics {
+                subject, parameter, ..
+            } => {
+                names.subject = match subject {
+                    // A body's coordinates are named `body.x`, `body.y`, `body.theta`.
+                    Subject::Body(body) => m
+                        .coordinate_name(3 * body)
+                        .map(|x| x.strip_suffix(".x").unwrap_or(x)),
+                    Subject::Load(load) => m.load_name(load),
+                };
                 names.parameter = m.parameter_name(parameter);
             }
             SolveError::NonFinite {

@@ -69,6 +69,7 @@ mod mechanism;
 mod origin;
 #[cfg(test)]
 mod pendulum;
+mod physics;
 mod position;
 mod reactions;
 mod simulate;
@@ -89,6 +90,7 @@ pub use mechanism::{
     Accelerations, Forces, MarkerStorage, Matrix, Mechanism, Outputs, ParameterError,
     ParameterNames, Storage, Unit, Vector, Velocities,
 };
+pub use physics::{PhysicsFault, Subject, check_physics};
 pub use reactions::{
     DistanceReaction, GearReaction, GroundLoad, PrismaticReaction, RackReaction, RevoluteReaction,
     SlotReaction, WeldReaction,

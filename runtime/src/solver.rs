@@ -730,14 +730,17 @@ where
         })
     }
 
-    /// Every parameter finite, and the geometry written in them valid: a NaN set through a
-    /// public field, or a distance set negative, is reported as itself, not as the NaN Φ or
-    /// the singular Jacobian it would cause.
+    /// Every parameter finite, and the geometry and physics written in them valid: a NaN set
+    /// through a public field, a distance or a mass set negative, is reported as itself, not as
+    /// the NaN Φ, the singular Jacobian or the wrong forces it would cause.
     pub(crate) fn check_parameters(&self, t: f64) -> Result<(), SolveError> {
         let m = &self.mechanism;
         match (0..m.parameter_count()).find(|&i| !m.parameter(i).is_some_and(f64::is_finite)) {
             Some(index) => Err(non_finite(t, Quantity::Parameter(index))),
-            None => m.check_geometry().map_err(|fault| fault.at(t)),
+            None => {
+                m.check_geometry().map_err(|fault| fault.at(t))?;
+                m.check_physics().map_err(|fault| fault.at(t))
+            }
         }
     }
 
