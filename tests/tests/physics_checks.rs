@@ -6,8 +6,7 @@
 
 use mechgen_cli::Interpreted;
 use mechgen_runtime::{
-    Dense, Requirement, SolveError, Solver, Structured, Subject, Vector,
-    nalgebra::DefaultAllocator,
+    Dense, Requirement, SolveError, Solver, Structured, Subject, Vector, nalgebra::DefaultAllocator,
 };
 use mechgen_tests::twin;
 
@@ -200,7 +199,11 @@ fn constant_physics_generates_no_check() {
         let tokens: proc_macro2::TokenStream = source.parse().unwrap();
         let code = mechgen::expand(tokens).unwrap().to_string();
         for item in ["check_physics", "load_name"] {
-            assert_eq!(code.contains(item), generated, "{item}, {generated}:\n{source}");
+            assert_eq!(
+                code.contains(item),
+                generated,
+                "{item}, {generated}:\n{source}"
+            );
         }
     }
 }
