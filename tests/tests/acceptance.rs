@@ -256,3 +256,52 @@ fn the_cli_exits_non_zero_above_acceptance() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+twin! {
+    RACKED_SCALED,
+    /// The rack and pinion at three scales: lengths times `s`.
+    mechanism RackedScaled {
+        param w = 1;
+        param s = 1;
+        ground frame at (0, 0, 0);
+        body pinion near (0, 0, 0);
+        body bar near (0, -10 * s, 0);
+        joint pivot: revolute(frame, pinion);
+        joint slide: prismatic(frame @ (0, -10 * s), bar, along (1, 0));
+        joint teeth: rack(slide, pinion, ratio 3.3 * s, phase 0.7 * s);
+        driver spin: angle(pinion) = w * t;
+    }
+}
+
+#[test]
+fn acceptance_of_closed_forms_is_in_scene_lengths_whatever_the_unit() {
+    // Powers of two scale every length without rounding: the scaled residuals, and so the
+    // outcomes, are the same bit for bit in micrometres, millimetres and metres. Measured in
+    // raw units instead, the rack's residual (a length) would be accepted or refused by scale.
+    let outcome = |s: f64, w: f64| {
+        let mut m = RackedScaled::default();
+        m.set_parameter("s", s).unwrap();
+        solve(m, w).map_err(|(error, _)| error)
+    };
+    let mut refused = 0;
+    for k in 0..=40 {
+        let w = 10f64.powf(k as f64 / 2.0);
+        let reference = outcome(1.0, w);
+        refused += usize::from(reference.is_err());
+        for s in [2f64.powi(-20), 2f64.powi(20)] {
+            let scaled = outcome(s, w);
+            match (&reference, &scaled) {
+                (Ok(a), Ok(b)) => assert_eq!(a, b, "w = {w:e}, s = {s:e}"),
+                (Err(a), Err(b)) => assert!(
+                    matches!(
+                        (a, b),
+                        (SolveError::Unresolved { .. }, SolveError::Unresolved { .. })
+                    ),
+                    "w = {w:e}, s = {s:e}: {a:?} {b:?}"
+                ),
+                _ => panic!("w = {w:e}, s = {s:e}: {reference:?} vs {scaled:?}"),
+            }
+        }
+    }
+    assert!(refused > 0 && refused < 41, "{refused}");
+}
