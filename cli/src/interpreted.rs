@@ -11,16 +11,17 @@ use std::cell::{Cell, RefCell};
 
 use mechgen::Scene;
 use mechgen::factor::Factorization;
-use mechgen::geometry;
 use mechgen::interpret::{Inputs, Tape};
 use mechgen::kinematics::LengthScale;
 use mechgen::reactions::ForceStage;
 use mechgen::structure::{self, Phase, Plan};
+use mechgen::{geometry, physics};
 use mechgen_runtime::first_load_fault;
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{
     Accelerations, Block, Forces, GeometryFault, Matrix, Mechanism, Names, Outputs, ParameterError,
-    Pattern, Quantity, Requirement, Stage, Structured, Unit, VecBuffers, Vector, Velocities,
+    Pattern, PhysicsFault, Quantity, Requirement, Stage, Structured, Subject, Unit, VecBuffers,
+    Vector, Velocities, check_physics,
 };
 
 /// A scene whose kinematics are interpreted rather than generated.
@@ -61,6 +62,9 @@ pub struct Interpreted {
     /// The geometry written in parameters: each value's rule, and one tape for the values.
     geometry: Vec<geometry::Check>,
     geometry_values: Tape,
+    /// The mass properties and load constants written in parameters, likewise.
+    physics: Vec<physics::Check>,
+    physics_values: Tape,
     branch_names: Vec<String>,
     /// Every name, `'static` for the errors the solver returns (interned, see `names`).
     names: &'static Names,
@@ -267,6 +271,8 @@ impl Interpreted {
         let lengths = Tape::new(arena, &kin.length_scale.dependent);
         let geometry_ids: Vec<_> = kin.geometry.iter().map(|c| c.value).collect();
         let geometry_values = Tape::new(arena, &geometry_ids);
+        let physics_ids: Vec<_> = kin.physics.iter().map(|c| c.value).collect();
+        let physics_values = Tape::new(arena, &physics_ids);
         let branches: Vec<Tape> = kin
             .branches
             .iter()
@@ -310,7 +316,7 @@ impl Interpreted {
             .chain(&gamma)
             .chain(forces.iter().flat_map(|(f, r)| [f, r]))
             .chain([&markers.0, &markers.1, &load_witnesses])
-            .chain([&lengths, &geometry_values])
+            .chain([&lengths, &geometry_values, &physics_values])
             .chain(&branches)
             .chain(&cached_branches)
             .chain(stages.iter().flat_map(PlanStage::tapes))
@@ -322,6 +328,7 @@ impl Interpreted {
             .max(model.dim())
             .max(kin.length_scale.dependent.len())
             .max(kin.geometry.len())
+            .max(kin.physics.len())
             .max(plan.largest_block() + plan.largest_slots())
             .max(kin.markers.len())
             .max(scene.load_witnesses.len())
@@ -359,6 +366,8 @@ impl Interpreted {
             lengths,
             geometry: kin.geometry.clone(),
             geometry_values,
+            physics: kin.physics.clone(),
+            physics_values,
             branch_names: model.branches.iter().map(|b| b.name.clone()).collect(),
             names: crate::names::intern([
                 vec![model.name.to_string()],
@@ -573,6 +582,23 @@ impl Mechanism for Interpreted {
                     c.equation,
                     c.parameter,
                 )
+            });
+        });
+        result
+    }
+
+    fn check_physics(&self) -> Result<(), PhysicsFault> {
+        let mut result = Ok(());
+        if self.physics.is_empty() {
+            return result;
+        }
+        self.run(&self.physics_values, self.inputs(&[], &[], 0.0), |v| {
+            result = self.physics.iter().zip(v).try_for_each(|(c, &value)| {
+                let subject = match c.subject {
+                    physics::Subject::Body(b) => Subject::Body(b),
+                    physics::Subject::Load(l) => Subject::Load(l),
+                };
+                check_physics(value, requirement(c.requirement), subject, c.parameter)
             });
         });
         result
@@ -1018,5 +1044,11 @@ fn requirement(requirement: geometry::Requirement) -> Requirement {
         geometry::Requirement::Distance => Requirement::Distance,
         geometry::Requirement::Angle => Requirement::Angle,
         geometry::Requirement::Axis => Requirement::Axis,
+        geometry::Requirement::Ratio => Requirement::Ratio,
+        geometry::Requirement::Mass => Requirement::Mass,
+        geometry::Requirement::Inertia => Requirement::Inertia,
+        geometry::Requirement::Stiffness => Requirement::Stiffness,
+        geometry::Requirement::FreeLength => Requirement::FreeLength,
+        geometry::Requirement::Damping => Requirement::Damping,
     }
 }

@@ -210,7 +210,7 @@ fn assembly_hint(error: &SolveError) -> &'static str {
             "a coordinate is too large to resolve: give `near` angles within a turn and \
              positions near the scene's size, and check parameters that set huge values"
         }
-        SolveError::Geometry { .. } => GEOMETRY_HINT,
+        SolveError::Geometry { .. } | SolveError::Physics { .. } => GEOMETRY_HINT,
         SolveError::Unreachable { .. } => {
             "start the run nearer t = 0 (`--t0`), or write the drivers so that the motion of \
              interest starts near t = 0"
@@ -245,7 +245,7 @@ fn step_hint(error: &SolveError) -> &'static str {
             "a coordinate has grown too large to resolve (a driven angle after very many \
              turns?): start the run at a smaller time, or drive the angle with a periodic law"
         }
-        SolveError::Geometry { .. } => GEOMETRY_HINT,
+        SolveError::Geometry { .. } | SolveError::Physics { .. } => GEOMETRY_HINT,
         SolveError::NonFinite {
             quantity: Quantity::LoadValue(_) | Quantity::SpringEnds(_),
             ..

@@ -1,6 +1,6 @@
 //! The run-time counterpart of [`crate::resolution`]: the scene's geometry written in parameters
-//! (body-fixed points, distances, ground poses, prismatic axes), each value with the rule it must
-//! satisfy, the joint it belongs to and a parameter it is computed from.
+//! (body-fixed points, distances, ground poses, prismatic axes, gear and rack ratios), each value
+//! with the rule it must satisfy, the joint it belongs to and a parameter it is computed from.
 //!
 //! Constant geometry is checked at compile time, at its tokens. These values are only known
 //! once the parameters are set, so the generated `check_geometry` (and the interpreter) evaluate
@@ -25,6 +25,18 @@ pub enum Requirement {
     Angle,
     /// A component of a unit axis: finite (the axis written is not the zero vector).
     Axis,
+    /// A gear's or rack's ratio: finite and not zero.
+    Ratio,
+    /// A body's mass: finite, at least zero ([`crate::physics`]).
+    Mass,
+    /// A body's moment of inertia: finite, at least zero.
+    Inertia,
+    /// A spring's stiffness: finite, at least zero.
+    Stiffness,
+    /// A spring's free length: at least zero, within the length range.
+    FreeLength,
+    /// A spring's damping coefficient: finite, at least zero.
+    Damping,
 }
 
 impl Requirement {
@@ -35,6 +47,12 @@ impl Requirement {
             Requirement::Distance => "Distance",
             Requirement::Angle => "Angle",
             Requirement::Axis => "Axis",
+            Requirement::Ratio => "Ratio",
+            Requirement::Mass => "Mass",
+            Requirement::Inertia => "Inertia",
+            Requirement::Stiffness => "Stiffness",
+            Requirement::FreeLength => "FreeLength",
+            Requirement::Damping => "Damping",
         }
     }
 }
@@ -99,15 +117,17 @@ fn values(kind: &ConstraintKind) -> Vec<(Id, Requirement)> {
         } => values.extend(axis.map(|id| (id, Requirement::Axis))),
         ConstraintKind::Distance { length, .. } => values.push((length, Requirement::Distance)),
         ConstraintKind::Weld { angle, .. } => values.push((angle, Requirement::Angle)),
-        ConstraintKind::Revolute { .. }
-        | ConstraintKind::Gear { .. }
-        | ConstraintKind::Driver { .. } => {}
+        ConstraintKind::Gear { ratio, .. } => values.push((ratio, Requirement::Ratio)),
+        ConstraintKind::Revolute { .. } | ConstraintKind::Driver { .. } => {}
+    }
+    if let ConstraintKind::Rack { ratio, .. } = *kind {
+        values.push((ratio, Requirement::Ratio));
     }
     values
 }
 
 /// The lowest-indexed parameter `id` reads; `None` for a constant.
-fn first_parameter(arena: &Arena, id: Id) -> Option<usize> {
+pub(crate) fn first_parameter(arena: &Arena, id: Id) -> Option<usize> {
     let lowest = Cell::new(None::<u32>);
     arena.any_node(id, |node| {
         if let Node::Param(i) = node {

@@ -41,6 +41,8 @@ pub struct Kinematics {
     pub length_scale: LengthScale,
     /// The geometry written in parameters, with the rule each value must satisfy at run time.
     pub geometry: Vec<crate::geometry::Check>,
+    /// The mass properties and load constants written in parameters, with their rules.
+    pub physics: Vec<crate::physics::Check>,
     /// The markers' values and rates, in layout order ([`Model::marker_names`]).
     pub markers: Vec<Id>,
 }
@@ -148,6 +150,7 @@ pub fn derive(model: &mut Model) -> Kinematics {
     let branches = branch_values(model);
     let length_scale = LengthScale::of(&model.arena, &model.lengths());
     let geometry = crate::geometry::checks(model);
+    let physics = crate::physics::checks(model);
     let markers = crate::markers::values(model);
     Kinematics {
         phi,
@@ -158,6 +161,7 @@ pub fn derive(model: &mut Model) -> Kinematics {
         branches,
         length_scale,
         geometry,
+        physics,
         markers,
     }
 }

@@ -30,6 +30,7 @@ pub mod limits;
 pub mod markers;
 pub mod model;
 pub mod parse;
+pub mod physics;
 pub mod reactions;
 pub mod resolution;
 pub mod source;

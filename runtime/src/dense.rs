@@ -153,6 +153,9 @@ where
     fn check_geometry(&self) -> Result<(), crate::GeometryFault> {
         self.inner.check_geometry()
     }
+    fn check_physics(&self) -> Result<(), crate::PhysicsFault> {
+        self.inner.check_physics()
+    }
     fn branch_count(&self) -> usize {
         self.inner.branch_count()
     }

@@ -8,6 +8,7 @@ use nalgebra::DefaultAllocator;
 use crate::geometry::{GeometryFault, Requirement};
 use crate::mechanism::{Mechanism, Storage};
 use crate::names::Names;
+use crate::physics::Subject;
 
 /// The quantity found to be NaN or infinite.
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
@@ -294,6 +295,26 @@ pub enum SolveError {
         #[cfg_attr(feature = "serde", serde(skip))]
         names: &'static Names,
     },
+    /// A mass property or load constant computed from parameters (a mass, an inertia, a
+    /// centre of mass, a spring's stiffness, free length or damping, a load's point) breaks
+    /// the rule constants obey at compile time, with the current parameter values: a negative
+    /// mass or stiffness. See [`crate::Mechanism::check_physics`].
+    Physics {
+        /// Time of the solve.
+        time: f64,
+        /// The body or load the value belongs to.
+        subject: Subject,
+        /// The first parameter (by index) the value is computed from.
+        parameter: usize,
+        /// The value.
+        value: f64,
+        /// What it must be.
+        requirement: Requirement,
+        /// The scene's names, which `Display` and `Debug` use ([`Names::NONE`] until the
+        /// solver attaches its mechanism's, [`crate::Mechanism::names`]).
+        #[cfg_attr(feature = "serde", serde(skip))]
+        names: &'static Names,
+    },
     /// A vector passed in does not have `dim()` entries (only possible with `Dyn` mechanisms).
     DimensionMismatch {
         /// The mechanism's `dim()`.
@@ -398,7 +419,8 @@ impl SolveError {
             | Self::BranchFlip { time, .. }
             | Self::NonFinite { time, .. }
             | Self::Geometry { time, .. }
-            | Self::Unreachable { time, .. } => Some(time),
+            | Self::Unreachable { time, .. }
+            | Self::Physics { time, .. } => Some(time),
             Self::DimensionMismatch { .. } => None,
         }
     }
@@ -415,6 +437,7 @@ impl SolveError {
             | Self::NonFinite { names, .. }
             | Self::Geometry { names, .. }
             | Self::Unreachable { names, .. }
+            | Self::Physics { names, .. }
             | Self::DimensionMismatch { names, .. } => names,
         }
     }
@@ -431,6 +454,7 @@ impl SolveError {
             | Self::NonFinite { names, .. }
             | Self::Geometry { names, .. }
             | Self::Unreachable { names, .. }
+            | Self::Physics { names, .. }
             | Self::DimensionMismatch { names, .. } => *names = table,
         }
         self
@@ -447,6 +471,7 @@ impl SolveError {
             Self::NonFinite { .. } => "NonFinite",
             Self::Geometry { .. } => "Geometry",
             Self::Unreachable { .. } => "Unreachable",
+            Self::Physics { .. } => "Physics",
             Self::DimensionMismatch { .. } => "DimensionMismatch",
         }
     }
@@ -633,6 +658,35 @@ impl SolveError {
                  mechanism at t = 0, and {steps} steps of its motion from there reached only \
                  t = {reached}; start nearer t = 0"
             ),
+            Self::Physics {
+                time,
+                subject,
+                parameter,
+                value,
+                requirement,
+                ..
+            } => {
+                write!(f, "invalid physics at t = {time}: a value of ")?;
+                match subject {
+                    // A body's coordinates are named `body.x`, `body.y`, `body.theta`.
+                    Subject::Body(index) => {
+                        let name = names.coordinate(3 * index);
+                        f.write_str("body ")?;
+                        write_name(f, name.map(|x| x.strip_suffix(".x").unwrap_or(x)), index)?;
+                    }
+                    Subject::Load(index) => {
+                        f.write_str("load ")?;
+                        write_name(f, names.load(index), index)?;
+                    }
+                }
+                write!(f, " is {value:e}, computed from ")?;
+                Quantity::Parameter(parameter).write(f, names)?;
+                write!(
+                    f,
+                    "; it is {}: set the parameter to a physical value",
+                    requirement.describe()
+                )
+            }
             Self::DimensionMismatch {
                 expected,
                 found,

@@ -1,4 +1,5 @@
-//! The rules a scene's parameter-dependent geometry must satisfy when it is solved.
+//! The rules a scene's parameter-dependent geometry (and, with [`crate::PhysicsFault`], its
+//! parameter-dependent mass properties and load constants) must satisfy when it is solved.
 //!
 //! `mechgen` checks constant geometry at compile time, at its tokens: a length folding to NaN,
 //! a distance that is not positive, a length out of range. Geometry written in parameters is
@@ -26,6 +27,18 @@ pub enum Requirement {
     /// A component of a prismatic joint's unit axis: finite (the direction written is
     /// not the zero vector, nor overflowing).
     Axis,
+    /// A gear's or rack's ratio: finite and not zero (a ratio of zero locks the driven side).
+    Ratio,
+    /// A body's mass: finite and at least zero.
+    Mass,
+    /// A body's moment of inertia: finite and at least zero.
+    Inertia,
+    /// A spring's stiffness: finite and at least zero.
+    Stiffness,
+    /// A spring's free length: at least zero and at most [`MAX_LENGTH`].
+    FreeLength,
+    /// A spring's damping coefficient: finite and at least zero.
+    Damping,
 }
 
 impl Requirement {
@@ -35,6 +48,11 @@ impl Requirement {
             Self::Length => value.abs() <= MAX_LENGTH,
             Self::Distance => value > 0.0 && value <= MAX_LENGTH,
             Self::Angle | Self::Axis => value.is_finite(),
+            Self::Ratio => value.is_finite() && value != 0.0,
+            Self::Mass | Self::Inertia | Self::Stiffness | Self::Damping => {
+                value.is_finite() && value >= 0.0
+            }
+            Self::FreeLength => (0.0..=MAX_LENGTH).contains(&value),
         }
     }
 
@@ -48,6 +66,12 @@ impl Requirement {
                 "a component of the unit axis, which must be finite (the direction must not \
                  be the zero vector)"
             }
+            Self::Ratio => "a gear or rack ratio, which must be finite and not zero",
+            Self::Mass => "a mass, which must be finite and at least zero",
+            Self::Inertia => "a moment of inertia, which must be finite and at least zero",
+            Self::Stiffness => "a stiffness, which must be finite and at least zero",
+            Self::FreeLength => "a free length, which must be at least zero and at most 1e100",
+            Self::Damping => "a damping coefficient, which must be finite and at least zero",
         }
     }
 }
@@ -97,7 +121,7 @@ mod tests {
     #[test]
     fn each_requirement_refuses_what_it_says() {
         use Requirement::*;
-        for requirement in [Length, Distance, Angle, Axis] {
+        for requirement in [Length, Distance, Angle, Axis, Ratio, Mass] {
             assert!(!requirement.holds(f64::NAN));
             assert!(!requirement.holds(f64::INFINITY));
             assert!(requirement.holds(1.5));
@@ -105,6 +129,15 @@ mod tests {
         assert!(Length.holds(-3.0) && Length.holds(0.0) && !Length.holds(2e100));
         assert!(!Distance.holds(0.0) && !Distance.holds(-1.0) && !Distance.holds(1e101));
         assert!(Angle.holds(-1e20) && Axis.holds(0.0));
+        assert!(!Ratio.holds(0.0) && Ratio.holds(-2.0));
+        for rule in [Mass, Inertia, Stiffness, FreeLength, Damping] {
+            assert!(rule.holds(0.0) && !rule.holds(-1e-300), "{rule:?}");
+            assert!(
+                !rule.holds(f64::NAN) && !rule.holds(f64::INFINITY),
+                "{rule:?}"
+            );
+        }
+        assert!(Mass.holds(1e200) && !FreeLength.holds(1e101));
         let fault = check_geometry(-2.0, Distance, 7, 1).unwrap_err();
         assert_eq!((fault.equation, fault.parameter, fault.value), (7, 1, -2.0));
         assert_eq!(check_geometry(2.0, Distance, 7, 1), Ok(()));

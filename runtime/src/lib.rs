@@ -55,6 +55,7 @@ extern crate alloc;
 #[cfg(test)]
 extern crate std;
 
+mod acceptance;
 mod assembly;
 mod block;
 mod crossing;
@@ -70,6 +71,7 @@ mod names;
 mod origin;
 #[cfg(test)]
 mod pendulum;
+mod physics;
 mod position;
 mod reactions;
 mod simulate;
@@ -91,6 +93,7 @@ pub use mechanism::{
     ParameterNames, Storage, Unit, Vector, Velocities,
 };
 pub use names::Names;
+pub use physics::{PhysicsFault, Subject, check_physics};
 pub use reactions::{
     DistanceReaction, GearReaction, GroundLoad, PrismaticReaction, RackReaction, RevoluteReaction,
     SlotReaction, WeldReaction,

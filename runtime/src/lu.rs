@@ -952,7 +952,7 @@ mod tests {
             None
         );
     }
-    use nalgebra::{Matrix3, U3, Vector3};
+    use nalgebra::{Matrix2, Matrix3, U2, U3, Vector2, Vector3};
 
     fn factored(m: Matrix3<f64>) -> Lu<U3> {
         let mut lu = Lu::new(U3);
@@ -1031,6 +1031,27 @@ mod tests {
             Lu::new(U3).factor(&Matrix3::zeros()),
             Err(LuError::Singular { column: 0, .. })
         ));
+    }
+
+    #[test]
+    fn names_the_remaining_row_that_depends_on_the_pivot_rows() {
+        // Row 2 = row 0 / 2; row 1 is independent. After the first step both remain, and the
+        // dependent one (all zero) is not the one in pivot position 1.
+        let m = Matrix3::new(2.0, 1.0, 0.0, 1.0, 0.5, 1.0, 1.0, 0.5, 0.0);
+        match Lu::new(U3).factor(&m) {
+            Err(LuError::Singular { row, column, .. }) => assert_eq!((row, column), (2, 1)),
+            other => panic!("expected a singular matrix, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn rank_reveal_refuses_an_elimination_that_overflows() {
+        // Finite entries whose first elimination step overflows to infinity (2 · MAX).
+        let big = f64::MAX;
+        let m = Matrix2::new(big, big, -big, big);
+        let ones = Vector2::new(1.0, 1.0);
+        let result = Lu::new(U2).reveal_rank(&ones, &ones, 1e-12, |a| a.copy_from(&m));
+        assert_eq!(result, Err(LuError::NonFinite));
     }
 
     #[test]

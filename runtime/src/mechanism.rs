@@ -258,6 +258,18 @@ where
         Ok(())
     }
 
+    /// Checks the mass properties and load constants written in parameters (masses,
+    /// inertias, centres of mass, spring constants, load points) against the compile-time
+    /// rules for constants, with the current parameter values; the solver calls it before
+    /// every solve, after [`Mechanism::check_geometry`]. Scenes whose physics is constant have
+    /// nothing to check (the default).
+    ///
+    /// # Errors
+    /// A [`crate::PhysicsFault`] for the first value that breaks its rule.
+    fn check_physics(&self) -> Result<(), crate::PhysicsFault> {
+        Ok(())
+    }
+
     /// Number of branch invariants the scene declares (`branch NAME: …;` in the spec).
     ///
     /// A branch invariant is a quantity whose sign tells two assembly branches apart (e.g. the

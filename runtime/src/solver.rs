@@ -6,6 +6,7 @@
 
 use nalgebra::{DefaultAllocator, Dim};
 
+use crate::acceptance::{self, Rounding};
 use crate::block::{BlockSolve, Factors};
 use crate::error::{Described, Quantity, SolveError};
 use crate::forces;
@@ -137,7 +138,10 @@ pub struct Convergence {
     pub iterations: usize,
     /// Largest ‖Φ_b‖∞ (unscaled) of the blocks at their last evaluation: at the returned
     /// positions, or, where the last correction was of round-off size, just before it.
-    /// Explicit assignments satisfy their equations to rounding.
+    /// Explicit assignments satisfy their equations to the rounding of the coordinates they
+    /// combine; where that rounding could reach `acceptance_tolerance` (coordinates beyond
+    /// ~4e4 scene lengths or radians), their residuals at the returned positions are
+    /// evaluated and included here.
     pub residual: f64,
     /// Largest condition estimate κ₁ of the scaled block Jacobians at the solution (1 without
     /// blocks; NaN if switched off).
@@ -509,13 +513,17 @@ where
         } = self;
         let mut parts = workspace.parts();
         let mut total = Convergence::start(options.estimate_condition);
+        // A looser residual tolerance asked for loosens acceptance with it (as in `position`).
+        let acceptance = options.acceptance_tolerance.max(options.residual_tolerance);
+        let mut rounding = Rounding::new(acceptance);
         // How much of the force solve's archive the blocks have filled.
         let mut archived = 0;
         for s in 0..m.stage_count() {
             *reached = s;
             match m.stage(s) {
-                Some(Stage::Explicit { .. }) => {
+                Some(Stage::Explicit { coordinates, .. }) => {
                     m.assign_positions(s, q, parts.trig, t);
+                    rounding.explicit(m, coordinates, q, length);
                     m.fill_trig(s, q, parts.trig);
                     assign_rates(m, s, q, parts.trig, qd, qdd, t, rates);
                 }
@@ -528,6 +536,7 @@ where
                         .solve(q, rates != Rates::None)
                         .map_err(|e| record(e, m, s, newton.parts, diagnosed))?;
                     total.add(s, &solved, (newton.fallbacks, newton.evaluations));
+                    rounding.block::<M>(block.coordinates, newton.parts.scales.inverse_cols, q);
                     m.fill_trig(s, q, newton.parts.trig);
                     block_rates(
                         &newton.bs,
@@ -552,6 +561,10 @@ where
         // (or earlier, as the non-finite Φ or rate of a block that reads it).
         *reached = m.stage_count();
         check_finite(q, t, Quantity::Phi)?;
+        if rounding.pending() {
+            let explicit = acceptance::check_explicit(m, q, t, length, acceptance)?;
+            total.residual = total.residual.max(explicit);
+        }
         check_rates(qd, qdd, t, rates)?;
         check_branches(m, q, parts.trig, t)?;
         if let Some(Extras { reactions, markers }) = extras {
@@ -749,14 +762,17 @@ where
         })
     }
 
-    /// Every parameter finite, and the geometry written in them valid: a NaN set through a
-    /// public field, or a distance set negative, is reported as itself, not as the NaN Φ or
-    /// the singular Jacobian it would cause.
+    /// Every parameter finite, and the geometry and physics written in them valid: a NaN set
+    /// through a public field, a distance or a mass set negative, is reported as itself, not as
+    /// the NaN Φ, the singular Jacobian or the wrong forces it would cause.
     pub(crate) fn check_parameters(&self, t: f64) -> Result<(), SolveError> {
         let m = &self.mechanism;
         match (0..m.parameter_count()).find(|&i| !m.parameter(i).is_some_and(f64::is_finite)) {
             Some(index) => Err(non_finite(t, Quantity::Parameter(index))),
-            None => m.check_geometry().map_err(|fault| fault.at(t)),
+            None => {
+                m.check_geometry().map_err(|fault| fault.at(t))?;
+                m.check_physics().map_err(|fault| fault.at(t))
+            }
         }
     }
 

@@ -164,9 +164,17 @@ where
     Ok(())
 }
 
-/// ν = −Φ_t and γ = −d²Φ/ds² along the straight path (q + s q̇, t + s), by central
-/// differences of the generated Φ: their truncation error is O(h²) of the terms' scale (1e-5
-/// of it for h = 1e-4) and their round-off a few ε/h² of Φ's scale (the positions' magnitude).
+/// ν = −Φ_t and γ = −d²Φ/ds² along the straight path (q + s q̇, t + s), by differences of
+/// the generated Φ.
+///
+/// ν by a central difference (Φ's dependence on t alone is smooth on the scale of h). γ by
+/// central second differences with the step chosen from the local scale of Φ along the path: a
+/// distance driver's Φ = |d| − L has a singularity where its points meet, |d| / |ḋ| away along
+/// the path, and a fixed step near it (0.044 apart at 6 mm/s is within 100 steps of 1e-4) makes
+/// the truncation error, not γ, exceed any sensible tolerance. So the step is halved from 1e-3
+/// until two successive Richardson extrapolations (error O(h⁴)) agree, which they do once h is
+/// well inside the path's radius of convergence, and γ is compared with the last: to 1e-6 of
+/// its scale, plus the differences' round-off (a few ε/h² of Φ's scale).
 fn rates_match_differences<M>(
     mechanism: &M,
     q: &[f64],
@@ -185,7 +193,6 @@ where
         v
     };
     let (qv, qdv) = (vector(q), vector(qd));
-    let h = 1e-4;
     let phi = |s: f64, along: bool| {
         let shifted = if along { &qv + &qdv * s } else { qv.clone() };
         let mut out = Vector::<M::Dim>::zeros_generic(dim, col);
@@ -195,42 +202,84 @@ where
     let (mut nu, mut gamma) = (vector(q), vector(q));
     mechanism.nu(&qv, t, &mut nu);
     mechanism.gamma(&qv, &qdv, t, &mut gamma);
-    let nu_fd = (phi(h, false) - phi(-h, false)) / (-2.0 * h);
-    let gamma_fd = (phi(h, true) - phi(0.0, true) * 2.0 + phi(-h, true)) / (-h * h);
     let scale_of = |v: &Vector<M::Dim>| v.amax().max(1.0);
     let phi_scale = phi(0.0, true)
         .amax()
         .max(q.iter().fold(1.0f64, |m, x| m.max(x.abs())));
+
+    let h = 1e-4;
+    let nu_fd = (phi(h, false) - phi(-h, false)) / (-2.0 * h);
     let nu_error = (&nu - &nu_fd).amax();
     prop_assert!(
         nu_error <= 1e-6 * scale_of(&nu).max(phi_scale),
         "nu: {nu_error} at scale {}",
         scale_of(&nu)
     );
-    let gamma_error = (&gamma - &gamma_fd).amax();
+
+    let centre = phi(0.0, true);
+    let second = |h: f64| (phi(h, true) - &centre * 2.0 + phi(-h, true)) / (-h * h);
+    let richardson = |h: f64| (second(0.5 * h) * 4.0 - second(h)) / 3.0;
+    // Round-off of a second difference at step h (Richardson's weights add 5/3 of it).
+    let round_off = |h: f64| 64.0 * f64::EPSILON * phi_scale / (h * h);
+    let tolerance = 1e-6 * scale_of(&gamma);
+    let (mut h, mut estimate) = (1e-3, richardson(1e-3));
+    loop {
+        let finer = richardson(0.5 * h);
+        let change = (&finer - &estimate).amax();
+        (h, estimate) = (0.5 * h, finer);
+        if change <= tolerance + round_off(h) {
+            break;
+        }
+        // Below this the round-off dominates whatever the truncation error.
+        prop_assert!(h > 1e-6, "differences did not settle: change {change:e}");
+    }
+    let gamma_error = (&gamma - &estimate).amax();
     prop_assert!(
-        gamma_error <= 1e-5 * scale_of(&gamma) + 16.0 * f64::EPSILON * phi_scale / (h * h),
-        "gamma: {gamma_error} at scale {}",
+        gamma_error <= tolerance + round_off(0.5 * h),
+        "gamma: {gamma_error} at scale {} (step {h:e})",
         scale_of(&gamma)
     );
     Ok(())
 }
 
+#[test]
+fn library_rates_hold_where_the_distance_drivers_points_nearly_meet() {
+    // The state that made the fixed-step differences fail: the distance driver's points (lever
+    // @ (2, 0) and arm @ (0, 1)) 0.044 apart and approaching at 3 per unit time, so that Φ's
+    // singularity where they meet is 0.015 away along the path.
+    let mut q = vec![0.0; 24];
+    let mut qd = vec![0.0; 24];
+    // arm (body 5) at the origin: its point at (0, 1); lever (body 6) turned 0.
+    (q[18], q[19]) = (-2.0 + 0.044, 1.0);
+    (qd[18], qd[19], qd[20]) = (-3.0, 0.5, 1.0);
+    rates_match_differences(&Library::default(), &q, &qd, 0.25).unwrap();
+}
+
 /// Random states for the library scene: moderate positions and rates, t inside the rise laws'
 /// interval and the domain of `asin` and `acos`, and away from the kinks of `abs`, `min` and
-/// `max` (at 0.3, 0.5, 0.7), where differences straddle two slopes.
+/// `max` (at 0.3, 0.5, 0.7) and the spline's knots (0.4, where its third derivative jumps, and
+/// 0.8, past which it is held), where differences (steps up to 1e-3) would straddle them.
 fn library_states() -> impl Strategy<Value = (Vec<f64>, Vec<f64>, f64)> {
     (
         proptest::collection::vec(-6.0..6.0f64, 24),
         proptest::collection::vec(-3.0..3.0f64, 24),
         (0.01..0.9f64).prop_filter("away from a kink", |t| {
-            [0.3, 0.5, 0.7].iter().all(|k| (t - k).abs() > 1e-3)
+            [0.3, 0.4, 0.5, 0.7, 0.8]
+                .iter()
+                .all(|k| (t - k).abs() > 2e-3)
         }),
     )
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(200))]
+    // A fixed seed: every run checks the same states, and a failure is reproduced by rerunning,
+    // with nothing written into the tree.
+    #![proptest_config(ProptestConfig {
+        cases: 200,
+        failure_persistence: None,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x9E37_79B9),
+        ..ProptestConfig::default()
+    })]
 
     #[test]
     fn library_jacobian_matches_central_differences((q, _, t) in library_states()) {

@@ -9,6 +9,7 @@
 mod body;
 mod forces;
 mod markers;
+mod physics;
 mod plan;
 
 use std::cell::RefCell;
@@ -283,6 +284,7 @@ impl Context<'_> {
         });
         let length_scale = self.length_scale(kin);
         let check_geometry = self.check_geometry(kin);
+        let check_physics = self.check_physics(kin);
         let branch_methods = self.branch_methods(kin);
         let equations = self.textbook_functions(kin);
         let force_methods = self.forces.map(|forces| self.force_methods(forces));
@@ -383,6 +385,8 @@ impl Context<'_> {
                 #length_scale
 
                 #check_geometry
+
+                #check_physics
 
                 #branch_methods
 
