@@ -16,7 +16,7 @@ fn main() -> ExitCode {
              please report it together with the command line and the scene"
         );
     }));
-    let closed = stdout_was_closed();
+    let closed = startup::stdout_was_closed();
     let work = move || {
         let mut stderr = io::stderr().lock();
         let args = std::env::args_os().skip(1);
@@ -38,40 +38,51 @@ fn main() -> ExitCode {
     ExitCode::from(code)
 }
 
-/// Whether standard output was closed when mechgen started (`mechgen solve … >&-`). Rust's
-/// runtime reopens a closed standard descriptor on `/dev/null`, read-write, so writes to it
-/// would "succeed" and a run would report rows it never wrote; a redirection to `/dev/null`
-/// opens it write-only, and stays a success. Read from `/proc` (Linux); elsewhere standard
+/// Whether standard output was closed when mechgen started (`mechgen solve … >&-`).
+///
+/// Rust's runtime reopens a closed standard descriptor on `/dev/null` before `main`, so writes
+/// to it would "succeed" and a run would report rows it never wrote. Nothing in `main` can tell
+/// that descriptor from a `/dev/null` the caller opened on purpose (`> /dev/null`, or Python's
+/// `subprocess.DEVNULL`, read-write like the runtime's), so the descriptor is looked at before
+/// the runtime touches it: a function in `.init_array` runs before Rust's start-up code. That
+/// needs `unsafe` (an FFI call and a link section), which the workspace otherwise denies: one
+/// `fcntl(1, F_GETFD)`, which only reads the descriptor's flags. Elsewhere than Linux standard
 /// output is taken as open.
-fn stdout_was_closed() -> bool {
-    #[cfg(target_os = "linux")]
-    {
-        use std::os::unix::fs::MetadataExt;
-        const ACCESS_MODE: u32 = 0o3;
-        const READ_WRITE: u32 = 0o2;
-        let Ok(info) = std::fs::read_to_string("/proc/self/fdinfo/1") else {
-            return false;
-        };
-        let flags = info
-            .lines()
-            .find_map(|line| line.strip_prefix("flags:"))
-            .and_then(|flags| u32::from_str_radix(flags.trim(), 8).ok());
-        let same_file = |a: &std::fs::Metadata, b: &std::fs::Metadata| {
-            (a.dev(), a.ino(), a.rdev()) == (b.dev(), b.ino(), b.rdev())
-        };
-        match (
-            flags,
-            std::fs::metadata("/proc/self/fd/1"),
-            std::fs::metadata("/dev/null"),
-        ) {
-            (Some(flags), Ok(stdout), Ok(null)) => {
-                flags & ACCESS_MODE == READ_WRITE && same_file(&stdout, &null)
-            }
-            _ => false,
-        }
+#[cfg(target_os = "linux")]
+#[allow(unsafe_code)]
+mod startup {
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
+
+    unsafe extern "C" {
+        fn fcntl(fd: i32, cmd: i32, ...) -> i32;
     }
-    #[cfg(not(target_os = "linux"))]
-    false
+
+    /// `F_GETFD` on Linux (every architecture).
+    const F_GETFD: i32 = 1;
+
+    extern "C" fn record_stdout() {
+        // SAFETY: `F_GETFD` reads the descriptor's flags and has no other effect; a closed
+        // descriptor makes it return -1 (EBADF).
+        let closed = unsafe { fcntl(1, F_GETFD) } == -1;
+        STDOUT_CLOSED.store(closed, Ordering::Relaxed);
+    }
+
+    #[used]
+    #[unsafe(link_section = ".init_array")]
+    static RECORD_STDOUT: extern "C" fn() = record_stdout;
+
+    pub fn stdout_was_closed() -> bool {
+        STDOUT_CLOSED.load(Ordering::Relaxed)
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+mod startup {
+    pub fn stdout_was_closed() -> bool {
+        false
+    }
 }
 
 /// Standard output that was closed: every write fails, as it would on the closed descriptor.
@@ -80,8 +91,7 @@ struct Closed;
 impl Write for Closed {
     fn write(&mut self, _: &[u8]) -> io::Result<usize> {
         Err(io::Error::other(
-            "standard output is closed (a read-write /dev/null counts as closed: `>&-` leaves \
-             one); redirect it with `> FILE` or `> /dev/null`",
+            "standard output is closed; redirect it with `> FILE` or `> /dev/null`",
         ))
     }
 

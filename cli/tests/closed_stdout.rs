@@ -1,5 +1,5 @@
 //! `mechgen` with standard output closed (`>&-`) fails as it does on a full device, instead of
-//! reporting rows it never wrote; a redirection to `/dev/null` still succeeds.
+//! reporting rows it never wrote; `/dev/null`, write-only or read-write, still succeeds.
 
 use std::process::{Command, Output};
 
@@ -30,8 +30,12 @@ fn a_closed_stdout_fails_like_a_full_one() {
         let full = mechgen_with_stdout("> /dev/full", command);
         assert_eq!(full.status.code(), Some(1), "{command}");
 
-        let null = mechgen_with_stdout("> /dev/null", command);
-        let stderr = String::from_utf8_lossy(&null.stderr);
-        assert!(null.status.success(), "{command}: {stderr}");
+        // Write-only (`>`) and read-write (`<>`, as Python's `subprocess.DEVNULL` opens it,
+        // and as Rust's runtime reopens a closed descriptor): both are a caller's choice.
+        for null in ["> /dev/null", "1<> /dev/null"] {
+            let out = mechgen_with_stdout(null, command);
+            let stderr = String::from_utf8_lossy(&out.stderr);
+            assert!(out.status.success(), "{command} {null}: {stderr}");
+        }
     }
 }

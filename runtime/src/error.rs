@@ -809,7 +809,29 @@ mod tests {
                     steps: 100_000,
                     names,
                 },
-                &["t = 3", "t = 0.5", "100000 steps"],
+                &[],
+            ),
+            (
+                SolveError::Physics {
+                    time: 0.5,
+                    subject: crate::physics::Subject::Body(0),
+                    parameter: 1,
+                    value: -1.0,
+                    requirement: Requirement::Mass,
+                    names,
+                },
+                &["body `crank`", "parameter `length`"],
+            ),
+            (
+                SolveError::Physics {
+                    time: 0.5,
+                    subject: crate::physics::Subject::Load(0),
+                    parameter: 0,
+                    value: -1.0,
+                    requirement: Requirement::Stiffness,
+                    names,
+                },
+                &["load `gas`", "parameter `omega`"],
             ),
             (
                 SolveError::NoAssembly {
