@@ -5,6 +5,11 @@
 #![no_std]
 #![no_main]
 #![deny(unsafe_code)]
+// Built without either scene only to measure the rest of the firmware's size.
+#![cfg_attr(
+    not(any(feature = "kinematics", feature = "dynamics")),
+    allow(dead_code)
+)]
 
 mod report;
 mod stack;
@@ -13,7 +18,11 @@ use cortex_m::peripheral::SYST;
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m_rt::entry;
 use cortex_m_semihosting::debug::{self, EXIT_FAILURE, EXIT_SUCCESS};
-use mechgen_embedded_trace::{Line, PistonCrank, PistonCrankDynamics, Revolution, STEPS, Scene};
+#[cfg(feature = "kinematics")]
+use mechgen_embedded_trace::PistonCrank;
+#[cfg(feature = "dynamics")]
+use mechgen_embedded_trace::PistonCrankDynamics;
+use mechgen_embedded_trace::{Line, Revolution, STEPS, Scene};
 use mechgen_runtime::Storage;
 use mechgen_runtime::nalgebra::DefaultAllocator;
 
@@ -38,8 +47,11 @@ fn run() -> Result<(), Failed> {
     let peripherals = cortex_m::Peripherals::take().ok_or(Failed)?;
     let mut clock = Clock::start(peripherals.SYST);
     calibrate(&mut clock, &mut out)?;
+    #[cfg(feature = "kinematics")]
     revolution(PistonCrank::default(), &mut clock, &mut out)?;
-    revolution(PistonCrankDynamics::default(), &mut clock, &mut out)
+    #[cfg(feature = "dynamics")]
+    revolution(PistonCrankDynamics::default(), &mut clock, &mut out)?;
+    Ok(())
 }
 
 /// Emulated instructions per SysTick tick: the AN386's processor clock is 25 MHz (40 ns a
