@@ -849,7 +849,7 @@ where
             }
         }
     }
-    undetermined[..count].sort_unstable();
+    crate::lu::sort_indices(&mut undetermined[..count]);
     *diagnosed = (deficiency, count);
     error
 }
