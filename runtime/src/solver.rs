@@ -1101,7 +1101,14 @@ mod tests {
             assert!(all_finite(v));
         }
         // The extremes of the finite range, either sign, subnormal and zero, are finite.
-        let extremes = [f64::MAX, -f64::MAX, f64::MIN_POSITIVE, 5e-324, -5e-324, -0.0];
+        let extremes = [
+            f64::MAX,
+            -f64::MAX,
+            f64::MIN_POSITIVE,
+            5e-324,
+            -5e-324,
+            -0.0,
+        ];
         assert!(all_finite(&extremes));
     }
 
