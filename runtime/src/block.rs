@@ -398,8 +398,8 @@ where
             rows[k] = self.block.equations[rows[rank + k]];
             columns[k] = self.block.coordinates[columns[rank + k]];
         }
-        rows[..deficiency].sort_unstable();
-        columns[..deficiency].sort_unstable();
+        crate::lu::sort_indices(&mut rows[..deficiency]);
+        crate::lu::sort_indices(&mut columns[..deficiency]);
         Ok(deficiency)
     }
 }
