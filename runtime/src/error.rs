@@ -546,9 +546,21 @@ impl SolveError {
             } => {
                 write!(
                     f,
-                    "the positions at t = {time} cannot be resolved in double precision: after \
-                     {iterations} iterations the corrections reached the rounding of the \
-                     coordinates, but ‖Φ‖∞ = {residual:.3e} remains, largest in equation "
+                    "the positions at t = {time} cannot be resolved in double precision: "
+                )?;
+                // An explicit stage assigns in closed form, without iterations.
+                if iterations == 0 {
+                    f.write_str("assigned in closed form")?;
+                } else {
+                    write!(
+                        f,
+                        "after {iterations} iterations the corrections reached the rounding of \
+                         the coordinates"
+                    )?;
+                }
+                write!(
+                    f,
+                    ", but ‖Φ‖∞ = {residual:.3e} remains, largest in equation "
                 )?;
                 equation(f, index)?;
                 f.write_str(
