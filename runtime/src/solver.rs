@@ -159,7 +159,7 @@ pub struct Convergence {
     /// between them; [`crate::Simulation`] watches it to catch toggle crossings.
     pub orientation: i8,
     /// Which blocks have a negative determinant: the XOR of a 64-bit code per such block
-    /// ([`crate::crossing::block_code`], distinct and non-zero for every stage). Two states
+    /// (a splitmix64 code of the stage index, distinct and non-zero for every stage). Two states
     /// whose blocks' signs differ have a singular configuration between them even when an even
     /// number of blocks flipped and `orientation` did not change; the codes of two different
     /// blocks never cancel (three or more could, with a chance of order 2⁻⁶⁴).
