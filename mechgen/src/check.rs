@@ -1144,7 +1144,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::parse::parse_str;
+    use crate::source::parse_str;
 
     fn errors(source: &str) -> Vec<String> {
         let spec = parse_str(source).unwrap_or_else(|e| panic!("syntax: {e}"));

@@ -78,7 +78,7 @@ pub fn compile(tokens: TokenStream) -> Result<Scene, Errors> {
 /// # Errors
 /// As [`compile`].
 pub fn compile_str(source: &str) -> Result<Scene, Errors> {
-    let spec = parse::parse_str(source)?;
+    let spec = source::parse_str(source)?;
     scene(&spec)
 }
 

@@ -49,18 +49,6 @@ pub fn parse_tokens(tokens: TokenStream) -> syn::Result<Spec> {
     syn::parse2(tokens)
 }
 
-/// Parses a `mechanism` declaration from source text (a `.mech` file) within the default
-/// [`Limits`](crate::limits::Limits), statement by statement (`source`).
-///
-/// The spans count lines and columns from the start of the chunk they were lexed in: place
-/// them in the text with [`crate::source::read`]'s locations.
-///
-/// # Errors
-/// The first limit exceeded, bracket problem, lexical or syntax error, at its position.
-pub fn parse_str(source: &str) -> syn::Result<Spec> {
-    crate::source::read(source, &crate::limits::Limits::default()).spec
-}
-
 /// `/// docs pub mechanism Name`: everything before the body.
 pub(crate) fn header(input: ParseStream) -> syn::Result<(Vec<Attribute>, Visibility, Ident)> {
     let docs = doc_attributes(input)?;
@@ -965,6 +953,7 @@ fn number(digits: &str, suffix: &str, span: proc_macro2::Span) -> syn::Result<Ex
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::source::parse_str;
 
     fn show(e: &Expr) -> String {
         match &e.kind {

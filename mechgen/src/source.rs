@@ -66,6 +66,18 @@ impl Locations {
     }
 }
 
+/// Parses a `mechanism` declaration from source text (a `.mech` file) within the default
+/// [`Limits`], statement by statement ([`read`]).
+///
+/// The spans count lines and columns from the start of the chunk they were lexed in: place
+/// them in the text with [`read`]'s locations.
+///
+/// # Errors
+/// The first limit exceeded, bracket problem, lexical or syntax error, at its position.
+pub fn parse_str(source: &str) -> syn::Result<Spec> {
+    read(source, &Limits::default()).spec
+}
+
 /// Reads `source` within `limits`: scans it, then lexes and parses it chunk by chunk.
 pub fn read(source: &str, limits: &Limits) -> Read {
     let mut locations = Locations::default();

@@ -58,6 +58,7 @@ extern crate std;
 mod acceptance;
 mod assembly;
 mod block;
+mod block_signs;
 mod crossing;
 mod dense;
 mod error;

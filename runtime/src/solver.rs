@@ -197,7 +197,7 @@ impl Convergence {
         self.evaluations += evaluations;
         if block.orientation < 0.0 {
             self.orientation = -self.orientation;
-            self.block_signs ^= crate::crossing::block_code(stage);
+            self.block_signs ^= crate::block_signs::block_code(stage);
         }
         self.swept |= block.swept;
     }

@@ -254,7 +254,7 @@ impl Checker {
 #[cfg(test)]
 mod tests {
     use crate::model::{LoadKind, Outputs};
-    use crate::parse::parse_str;
+    use crate::source::parse_str;
 
     const ARM: &str = "
         ground frame at (0, 0, 0);
