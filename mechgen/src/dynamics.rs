@@ -19,7 +19,7 @@ use std::collections::HashMap;
 
 use crate::diff::Differentiator;
 use crate::expr::{Arena, Func, Id, Var, var_index};
-use crate::kinematics::{Frames, ground_poses};
+use crate::frames::{Frames, ground_poses};
 use crate::model::{LoadKind, Model, Point};
 
 /// The pull of the springs anchored to ground bodies on those bodies' coordinates (zero

@@ -22,6 +22,7 @@ pub mod emit;
 pub mod error;
 pub mod expr;
 pub mod factor;
+mod frames;
 pub mod geometry;
 pub mod graph;
 pub mod interpret;

@@ -6,7 +6,7 @@
 
 use crate::diff::Differentiator;
 use crate::expr::Id;
-use crate::kinematics::{Frames, ground_poses};
+use crate::frames::{Frames, ground_poses};
 use crate::model::{MarkerKind, Model, Outputs};
 
 /// Every marker's values in layout order ([`Model::marker_names`]): its positions, then their

@@ -19,7 +19,7 @@ use nalgebra::DefaultAllocator;
 
 use crate::lu::{self, LuError};
 use crate::mechanism::{LengthScale, Storage, Vector};
-use crate::solver::SolverOptions;
+use crate::options::SolverOptions;
 use crate::structure::{Block, Pattern, Structured};
 use crate::workspace::{Estimator, FactorStorage, Scales};
 

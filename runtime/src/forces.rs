@@ -17,10 +17,11 @@ use nalgebra::DefaultAllocator;
 
 use crate::block::{BlockSolve, Factors};
 use crate::error::{Quantity, SolveError};
+use crate::finite::{all_finite, check_finite, non_finite};
 use crate::mechanism::{LengthScale, Storage, Vector};
 use crate::names::Names;
+use crate::options::SolverOptions;
 use crate::position::Newton;
-use crate::solver::{SolverOptions, all_finite, check_finite, non_finite};
 use crate::structure::{Stage, Structured};
 use crate::workspace::Parts;
 

@@ -62,6 +62,7 @@ mod block_signs;
 mod crossing;
 mod dense;
 mod error;
+mod finite;
 mod forces;
 mod geometry;
 mod lu;
@@ -69,6 +70,7 @@ mod markers;
 pub mod math;
 mod mechanism;
 mod names;
+mod options;
 mod origin;
 #[cfg(test)]
 mod pendulum;
@@ -94,13 +96,14 @@ pub use mechanism::{
     ParameterNames, Storage, Unit, Vector, Velocities,
 };
 pub use names::Names;
+pub use options::SolverOptions;
 pub use physics::{PhysicsFault, Subject, check_physics};
 pub use reactions::{
     DistanceReaction, GearReaction, GroundLoad, PrismaticReaction, RackReaction, RevoluteReaction,
     SlotReaction, WeldReaction,
 };
 pub use simulate::{DEFAULT_MAX_HALVINGS, Simulation, sample_time};
-pub use solver::{Convergence, Solver, SolverOptions};
+pub use solver::{Convergence, Solver};
 pub use state::{BodyState, Pose, PoseVelocity, State, write_csv_header};
 pub use structure::{Block, Pattern, Stage, Structured};
 #[cfg(feature = "alloc")]

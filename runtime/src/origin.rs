@@ -10,7 +10,7 @@ use nalgebra::DefaultAllocator;
 use crate::error::{Quantity, SolveError};
 use crate::mechanism::{Storage, Vector};
 use crate::names::Names;
-use crate::solver::Rates;
+use crate::options::Rates;
 use crate::structure::{Stage, Structured};
 
 /// `error`, re-attributed to the first explicit stage before `reached` (the stage being solved

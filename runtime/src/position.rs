@@ -25,10 +25,11 @@ use nalgebra::DefaultAllocator;
 
 use crate::block::{BlockSolve, Factors};
 use crate::error::{Quantity, SolveError};
+use crate::finite::{all_finite, non_finite};
 use crate::lu::{self, LuError};
 use crate::mechanism::{Storage, Vector};
 use crate::names::Names;
-use crate::solver::{SolverOptions, all_finite, non_finite};
+use crate::options::SolverOptions;
 use crate::structure::Structured;
 use crate::workspace::Parts;
 

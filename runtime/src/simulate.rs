@@ -200,7 +200,7 @@ where
     /// [`Simulation::step_to`], with errors from the solver (named) and of its own (not yet).
     fn step(&mut self, t: f64) -> Result<&State<M>, SolveError> {
         if !t.is_finite() {
-            return Err(crate::solver::non_finite(t, Quantity::Time));
+            return Err(crate::finite::non_finite(t, Quantity::Time));
         }
         match self.advance(t, false) {
             Outcome::Solved => {}

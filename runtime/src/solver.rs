@@ -1,4 +1,4 @@
-//! The solver: its options, unit scaling, and the solve itself, which works through the scene's
+//! The solver: unit scaling and the solve itself (its options are in `options`), which works through the scene's
 //! stages in order. Each explicit stage is assigned in closed form; each block is solved by
 //! Newton's method (`position.rs`) and, right after, its velocities and accelerations are
 //! solved with the same factors: a block's derivatives depend only on earlier stages, so one
@@ -9,126 +9,16 @@ use nalgebra::{DefaultAllocator, Dim};
 use crate::acceptance::{self, Rounding};
 use crate::block::{BlockSolve, Factors};
 use crate::error::{Described, Quantity, SolveError};
+use crate::finite::{all_finite, check_finite, check_slice, non_finite};
 use crate::forces;
-use crate::lu::DEFAULT_PIVOT_TOLERANCE;
-use crate::mechanism::{
-    Accelerations, LengthScale, Mechanism, Outputs, Storage, Vector, Velocities,
-};
+use crate::mechanism::{Accelerations, LengthScale, Mechanism, Storage, Vector, Velocities};
 use crate::names::Names;
+use crate::options::{Rates, SolverOptions};
 use crate::origin;
 use crate::position::{Newton, Solved};
 use crate::state::State;
 use crate::structure::{Block, Stage, Structured};
 use crate::workspace::{Parts, Workspace};
-
-/// Tolerances and safeguards of the solve.
-///
-/// Tolerances apply to the unit-scaled system (see [`crate::Unit`]): lengths are measured in
-/// units of the scene's [`crate::Mechanism::length_scale`], angles in radians, and both
-/// relative to `max(1, ‖D_c⁻¹ q_b‖∞)` over the coordinates of the block being solved (so a
-/// coupler that has turned a million radians is still resolved to round-off). The same options
-/// then suit a micro-mechanism in metres and an engine in millimetres.
-///
-/// ```
-/// # use mechgen_runtime::mechanism;
-/// # mechanism! {
-/// #     /// A slider-crank (mm, rad, s).
-/// #     pub mechanism SliderCrank {
-/// #         param omega = 10.0;
-/// #         ground frame at (0, 0, 0);
-/// #         body crank near (0, 0, 0.5);
-/// #         body rod near (35, 19, -0.19);
-/// #         body slider near (133, 0, 0);
-/// #         joint pivot: revolute(frame, crank);
-/// #         joint crank_pin: revolute(crank @ (40, 0), rod);
-/// #         joint wrist: revolute(rod @ (100, 0), slider);
-/// #         joint guide: prismatic(frame, slider, along (1, 0));
-/// #         driver turn: angle(crank) = 0.5 + omega * t;
-/// #     }
-/// # }
-/// use mechgen_runtime::{Simulation, Solver, SolverOptions};
-///
-/// // Tighter than the default, and without the condition estimate (a little faster).
-/// let options = SolverOptions {
-///     residual_tolerance: 1e-13,
-///     estimate_condition: false,
-///     ..SolverOptions::default()
-/// };
-/// let simulation = Simulation::new(Solver::with_options(SliderCrank::default(), options), 0.0)?;
-/// assert!(simulation.state().condition.is_nan());
-/// # Ok::<(), mechgen_runtime::SolveError>(())
-/// ```
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SolverOptions {
-    /// A first Newton correction ends the iteration only from a point whose scaled residual
-    /// ‖D_r Φ_b‖∞ is within `residual_tolerance` (default 1e-10; times the magnitude above).
-    pub residual_tolerance: f64,
-    /// Converged once a scaled Newton correction is within `step_tolerance` (default 1e-10) and
-    /// convergence is evident (see the `position` module: quadratic contraction, or a first
-    /// correction from a point within `residual_tolerance`).
-    pub step_tolerance: f64,
-    /// A solution is accepted only when its scaled residual ‖D_r Φ_b‖∞ is within this, in
-    /// scene lengths and radians, whatever the size of the coordinates (default 1e-8). The step
-    /// and residual tolerances above are relative to the coordinates' magnitude, so that a
-    /// crank that has turned for hours still converges; this absolute test is what keeps a
-    /// coordinate too large to resolve (an angle of 1e12 rad, whose rounding alone is 1e-4)
-    /// from being accepted: such a solve fails with [`SolveError::Unresolved`]. A looser
-    /// `residual_tolerance` (a work-precision sweep) loosens it to that.
-    pub acceptance_tolerance: f64,
-    /// Updates (Newton, damped or Levenberg–Marquardt) per block before giving up (default 50).
-    pub max_iterations: usize,
-    /// Relative pivot tolerance τ of the scaled block Jacobians: a pivot counts as zero when
-    /// `|u_kk| ≤ τ · n · max|s_ij|` (default [`DEFAULT_PIVOT_TOLERANCE`]).
-    pub pivot_tolerance: f64,
-    /// Factor blocks with the pivot order the scene fixed at generation time (default true).
-    /// Off, every block is factored with partial pivoting: only for comparisons.
-    pub static_pivots: bool,
-    /// Threshold u of the static pivots (default 0.1): a static pivot is kept while it is at
-    /// least u times every other entry of its column in the remaining submatrix (multipliers at
-    /// most 1/u, as in threshold partial pivoting). When one is not, the block is refactored
-    /// with partial pivoting, and the fallback is counted ([`crate::State::fallbacks`]).
-    pub static_pivot_threshold: f64,
-    /// Largest condition estimate of a scaled block Jacobian accepted at a solution (default
-    /// 1e8).
-    ///
-    /// Above it the solve fails with [`SolveError::Singular`]. Two reasons set the default.
-    /// Velocities and accelerations lose about log₁₀(κ) digits, so 1e8 still leaves eight.
-    /// And at a double root (a toggle position), Newton places the solution only about √ε
-    /// away, where κ is of order 1/√ε ≈ 7e7 times the scene's own constants (about 1e9 for a
-    /// slider-crank whose rod equals its crank). A limit above that would accept such a point,
-    /// with velocities halfway between the two branches that meet there.
-    pub max_condition: f64,
-    /// Largest scaled Newton step (default 1): a step is shortened to move no coordinate by
-    /// more than this many scene lengths or radians, so a bad guess cannot throw the iterate
-    /// across the mechanism.
-    pub max_step: f64,
-    /// Scale equations and coordinates by their units (default true). Off, tolerances and the
-    /// condition estimate apply to raw values: only for measuring what scaling costs.
-    pub scale_units: bool,
-    /// Estimate the condition of every block at its solution (default true). Off,
-    /// `max_condition` is not checked and states report a NaN condition: only for measuring
-    /// what the estimate costs.
-    pub estimate_condition: bool,
-}
-
-impl Default for SolverOptions {
-    fn default() -> Self {
-        Self {
-            residual_tolerance: 1e-10,
-            step_tolerance: 1e-10,
-            acceptance_tolerance: 1e-8,
-            max_iterations: 50,
-            pivot_tolerance: DEFAULT_PIVOT_TOLERANCE,
-            static_pivots: true,
-            static_pivot_threshold: 0.1,
-            max_condition: 1e8,
-            max_step: 1.0,
-            scale_units: true,
-            estimate_condition: true,
-        }
-    }
-}
 
 /// Outcome of a successful position solve, over all blocks.
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
@@ -284,28 +174,6 @@ where
 {
     reactions: &'a mut Vector<M::Dim>,
     markers: &'a mut M::Markers,
-}
-
-/// What a stage sweep computes besides positions: ordered, each level including the ones
-/// before it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub(crate) enum Rates {
-    None,
-    Velocities,
-    Both,
-    /// Both rates, then the force solve in reverse.
-    Forces,
-}
-
-impl Rates {
-    fn of(outputs: Outputs) -> Self {
-        match outputs {
-            Outputs::Positions => Rates::None,
-            Outputs::Velocities => Rates::Velocities,
-            Outputs::Accelerations => Rates::Both,
-            Outputs::Forces => Rates::Forces,
-        }
-    }
 }
 
 impl<M: Structured> Solver<M>
@@ -1068,51 +936,6 @@ fn larger(largest: f64, d: f64) -> f64 {
     }
 }
 
-/// A non-finite `quantity` that no single equation produced (an input, a step).
-pub(crate) fn non_finite(time: f64, quantity: Quantity) -> SolveError {
-    SolveError::NonFinite {
-        time,
-        quantity,
-        equation: None,
-        names: &Names::NONE,
-    }
-}
-
-pub(crate) fn check_finite<D: Dim>(
-    v: &Vector<D>,
-    t: f64,
-    quantity: Quantity,
-) -> Result<(), SolveError>
-where
-    DefaultAllocator: Storage<D>,
-{
-    check_slice(v.as_slice(), t, quantity)
-}
-
-#[inline]
-fn check_slice(v: &[f64], t: f64, quantity: Quantity) -> Result<(), SolveError> {
-    if all_finite(v) {
-        Ok(())
-    } else {
-        Err(non_finite(t, quantity))
-    }
-}
-
-/// Whether every entry is finite, without a branch per entry and without floating-point
-/// arithmetic: adding one to the exponent field carries into the sign bit exactly when the
-/// exponent is all ones (infinite or NaN). Integer AND, ADD and OR vectorise on the host as the
-/// floating-point test `x · 0` did, and on a controller without a double-precision FPU they
-/// are a few instructions where `x · 0` was two soft-float calls.
-#[inline]
-pub(crate) fn all_finite(v: &[f64]) -> bool {
-    const EXPONENT: u64 = 0x7ff0_0000_0000_0000;
-    const EXPONENT_ONE: u64 = 1 << 52;
-    let carried = v
-        .iter()
-        .fold(0, |acc, x| acc | ((x.to_bits() & EXPONENT) + EXPONENT_ONE));
-    carried >> 63 == 0
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1137,33 +960,6 @@ mod tests {
                 assert!((c - e).abs() <= 1e-12 * e.abs().max(1.0), "{c} vs {e}");
             }
         }
-    }
-
-    #[test]
-    fn all_finite_finds_any_infinite_or_nan_entry() {
-        for n in 0..=9 {
-            let mut storage = [1.5; 9];
-            let v = &mut storage[..n];
-            assert!(all_finite(v));
-            for k in 0..n {
-                for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-                    v[k] = bad;
-                    assert!(!all_finite(v), "{bad} at {k} of {n}");
-                }
-                v[k] = -f64::MAX;
-            }
-            assert!(all_finite(v));
-        }
-        // The extremes of the finite range, either sign, subnormal and zero, are finite.
-        let extremes = [
-            f64::MAX,
-            -f64::MAX,
-            f64::MIN_POSITIVE,
-            5e-324,
-            -5e-324,
-            -0.0,
-        ];
-        assert!(all_finite(&extremes));
     }
 
     #[test]
