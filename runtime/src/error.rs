@@ -74,27 +74,21 @@ impl Quantity {
     /// Writes the quantity, naming a parameter, branch or marker from `names` (its index
     /// otherwise).
     fn write(self, f: &mut fmt::Formatter<'_>, names: &dyn Lookup) -> fmt::Result {
-        let text = match self {
-            Self::Parameter(index) => {
-                f.write_str("parameter ")?;
-                return write_name(f, names.parameter(index), index);
-            }
-            Self::Branch(index) => {
-                f.write_str("branch invariant ")?;
-                return write_name(f, names.branch(index), index);
-            }
-            Self::Marker(index) => {
-                f.write_str("marker value ")?;
-                return write_name(f, names.marker(index), index);
-            }
-            Self::LoadValue(index) => {
-                f.write_str("the force or moment of load ")?;
-                return write_name(f, names.load(index), index);
-            }
-            Self::SpringEnds(index) => {
-                f.write_str("the force of spring ")?;
-                return write_name(f, names.load(index), index);
-            }
+        let (label, name, index) = match self {
+            Self::Parameter(i) => ("parameter ", names.parameter(i), i),
+            Self::Branch(i) => ("branch invariant ", names.branch(i), i),
+            Self::Marker(i) => ("marker value ", names.marker(i), i),
+            Self::LoadValue(i) => ("the force or moment of load ", names.load(i), i),
+            Self::SpringEnds(i) => ("the force of spring ", names.load(i), i),
+            _ => return f.write_str(self.text()),
+        };
+        f.write_str(label)?;
+        write_name(f, name, index)
+    }
+
+    /// What an unindexed quantity is called.
+    fn text(self) -> &'static str {
+        match self {
             Self::Time => "the time",
             Self::Guess => "the positions q (initial guess)",
             Self::Phi => "the constraints Φ",
@@ -106,8 +100,12 @@ impl Quantity {
             Self::Acceleration => "the accelerations q̈",
             Self::Load => "the applied and inertial forces F (loads, springs, masses)",
             Self::Reaction => "the reactions (constraint forces and driver efforts)",
-        };
-        f.write_str(text)
+            Self::Parameter(_)
+            | Self::Branch(_)
+            | Self::Marker(_)
+            | Self::LoadValue(_)
+            | Self::SpringEnds(_) => "",
+        }
     }
 }
 
