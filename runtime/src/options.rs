@@ -57,7 +57,7 @@ pub struct SolverOptions {
     /// and residual tolerances above are relative to the coordinates' magnitude, so that a
     /// crank that has turned for hours still converges; this absolute test is what keeps a
     /// coordinate too large to resolve (an angle of 1e12 rad, whose rounding alone is 1e-4)
-    /// from being accepted: such a solve fails with [`SolveError::Unresolved`]. A looser
+    /// from being accepted: such a solve fails with [`crate::SolveError::Unresolved`]. A looser
     /// `residual_tolerance` (a work-precision sweep) loosens it to that.
     pub acceptance_tolerance: f64,
     /// Updates (Newton, damped or Levenberg–Marquardt) per block before giving up (default 50).
@@ -76,7 +76,7 @@ pub struct SolverOptions {
     /// Largest condition estimate of a scaled block Jacobian accepted at a solution (default
     /// 1e8).
     ///
-    /// Above it the solve fails with [`SolveError::Singular`]. Two reasons set the default.
+    /// Above it the solve fails with [`crate::SolveError::Singular`]. Two reasons set the default.
     /// Velocities and accelerations lose about log₁₀(κ) digits, so 1e8 still leaves eight.
     /// And at a double root (a toggle position), Newton places the solution only about √ε
     /// away, where κ is of order 1/√ε ≈ 7e7 times the scene's own constants (about 1e9 for a
