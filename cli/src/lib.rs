@@ -8,8 +8,6 @@
 pub mod args;
 pub mod diagnostics;
 pub mod inspect;
-mod interpreted;
-mod names;
 pub mod solve;
 
 use std::ffi::OsString;
@@ -17,7 +15,7 @@ use std::io::{self, Read, Write};
 use std::path::Path;
 
 pub use args::Command;
-pub use interpreted::Interpreted;
+pub use mechgen_interp::Interpreted;
 
 use args::{Input, Output, SolveArgs, Times};
 use mechgen::limits::Limits;

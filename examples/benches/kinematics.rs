@@ -34,11 +34,11 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkGroup, Criterion, measurement::WallTime};
-use mechgen_cli::Interpreted;
 use mechgen_examples::closed_form;
 use mechgen_examples::inverse_dynamics::{MassProperties, seed_reactions};
 use mechgen_examples::report::{AutoDiff, CentralDifference, ForwardDifference, Plan};
 use mechgen_examples::scenes::{FourBar, OffsetSlider, PistonCrank, PistonCrankDynamics};
+use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{
     Dense, Matrix, Mechanism, Simulation, Solver, SolverOptions, State, Storage, Structured, Vector,

@@ -13,7 +13,7 @@
 //! phases) and a planetary gear train, so that mutants drive closed-form stages to huge angles
 //! (the numbers below include 1e12 to 1e20), where rounding alone breaks their constraints.
 
-use mechgen_cli::Interpreted;
+use mechgen_interp::Interpreted;
 use mechgen_runtime::{
     DEFAULT_MAX_HALVINGS, Mechanism, Outputs, Simulation, Solver, SolverOptions, Stage, Structured,
     Unit, Vector, nalgebra::Dyn,

@@ -9,7 +9,7 @@
 //! every magnitude from 1 to 1e20 rad; the residual of every accepted state is re-evaluated
 //! with the scene's unstructured Φ (not the plan's kernels).
 
-use mechgen_cli::Interpreted;
+use mechgen_interp::Interpreted;
 use mechgen_runtime::{Dense, Mechanism, SolveError, Solver, SolverOptions, Structured, Unit};
 use mechgen_runtime::{Vector, nalgebra::DefaultAllocator};
 use mechgen_tests::twin;

@@ -13,7 +13,7 @@ mod scene;
 
 use mechgen::CodegenOptions;
 use mechgen::builder::{Product, SceneBuilder, Sign};
-use mechgen_cli::Interpreted;
+use mechgen_interp::Interpreted;
 use mechgen_runtime::{Mechanism, Solver};
 
 #[test]

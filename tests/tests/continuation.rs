@@ -267,7 +267,7 @@ fn a_start_at_three_seconds_is_not_the_mirror() {
     let expected = lever_angle(3.0);
     assert!((expected - 2.4990).abs() < 1e-4, "{expected}");
     let scene = mechgen::compile_str(MIRROR_AT_START).unwrap();
-    let interpreted = mechgen_cli::Interpreted::new(&scene);
+    let interpreted = mechgen_interp::Interpreted::new(&scene);
     let simulation = Simulation::new(Solver::new(interpreted), 3.0).unwrap();
     let theta = simulation.state().q[MirrorAtStart::LEVER_THETA];
     assert!((theta - expected).abs() < 1e-10, "{theta}");

@@ -3,7 +3,7 @@
 //! run-time parameters change, in generated and interpreted code; the generated accessors
 //! follow the parameters; the generated code is a reviewed snapshot.
 
-use mechgen_cli::Interpreted;
+use mechgen_interp::Interpreted;
 use mechgen_runtime::{Mechanism, Simulation, Solver, sample_time};
 use mechgen_tests::twin;
 

@@ -3,7 +3,7 @@
 //! print), for a generated scene and for the same scene interpreted: the errors carry the
 //! scene's `'static` names.
 
-use mechgen_cli::Interpreted;
+use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::DVector;
 use mechgen_runtime::{
     Mechanism, Names, Quantity, Simulation, SolveError, Solver, Structured, mechanism,

@@ -16,7 +16,7 @@
 mod newton_euler;
 
 use mechgen::model::{ConstraintKind, Driven, LoadKind};
-use mechgen_cli::Interpreted;
+use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::{DefaultAllocator, Dim, Dyn};
 use mechgen_runtime::{Dense, Forces, Simulation, Solver, State, Storage, Structured};
 use newton_euler::corpus::{self, Scene};

@@ -15,10 +15,10 @@
 
 mod newton_euler;
 
-use mechgen_cli::Interpreted;
 use mechgen_examples::closed_form::PistonCrank as SeedMotion;
 use mechgen_examples::inverse_dynamics::{MassProperties, seed_reactions};
 use mechgen_examples::scenes::{PistonCrankDynamics, PistonCrankDynamicsForces};
+use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::DVector;
 use mechgen_runtime::{
     Dense, Forces, Quantity, Simulation, SolveError, Solver, SolverOptions, State, Structured,

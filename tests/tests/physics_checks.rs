@@ -4,7 +4,7 @@
 //! generated code, the interpreter, the dense reference and the CLI; a scene whose physics is
 //! constant generates no check.
 
-use mechgen_cli::Interpreted;
+use mechgen_interp::Interpreted;
 use mechgen_runtime::{
     Dense, Requirement, SolveError, Solver, Structured, Subject, Vector, nalgebra::DefaultAllocator,
 };

@@ -3,8 +3,8 @@
 //! against the interpreter on the same IR (Φ, Φ_q, ν, γ); for the example scenes and for a
 //! scene using every joint, driver, function and motion law of the library.
 
-use mechgen_cli::Interpreted;
 use mechgen_examples::scenes::{FourBar, PistonCrank};
+use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::{DMatrix, DVector, Dyn};
 use mechgen_runtime::{Accelerations, Matrix, Mechanism, Vector};
 use mechgen_tests::twin;

@@ -1,8 +1,8 @@
 //! The reliability holes a new user met, each closed: scenes that hung or exited 0 with a wrong
 //! answer now end in a solution whose constraints hold or in a typed error that says why.
 
-use mechgen_cli::Interpreted;
 use mechgen_examples::scenes::PistonCrank;
+use mechgen_interp::Interpreted;
 use mechgen_runtime::{Mechanism, Simulation, SolveError, Solver, Vector, nalgebra::Const};
 
 const SEED: &str = include_str!("../../examples/scenes/piston_crank.mech");

@@ -3,10 +3,10 @@
 //! closed forms (the seed at random scales and speeds, random slider-cranks), and against the interpreter following the same plan; the static pivots'
 //! fallback on a scene built to defeat them.
 
-use mechgen_cli::Interpreted;
 use mechgen_examples::closed_form;
 use mechgen_examples::scenes::{FourBar, OffsetSlider, PistonCrank};
 use mechgen_examples::stability::{FlexiblePistonCrank, SliderCrank};
+use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::{Const, DefaultAllocator};
 use mechgen_runtime::{
     Accelerations, Dense, Mechanism, Simulation, SolveError, Solver, SolverOptions, State, Storage,

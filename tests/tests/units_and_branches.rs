@@ -3,8 +3,8 @@
 //! the interpreter (`.mech` files through `Interpreted`), and the example scenes' declared
 //! branches hold along their whole motion.
 
-use mechgen_cli::Interpreted;
 use mechgen_examples::scenes::{FourBar, OffsetSlider, PistonCrank};
+use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::{Const, DVector};
 use mechgen_runtime::{Mechanism, Simulation, Solver, Structured, Unit, Vector};
 

@@ -3,7 +3,7 @@
 //! closed-form inverse dynamics (`inverse_dynamics`), and what a step with forces costs next to
 //! the kinematic seed step, both timed in the same interleaved passes.
 
-use mechgen_cli::Interpreted;
+use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{Dense, Forces, SolveError, Storage, Structured};
 

@@ -9,7 +9,7 @@
 //!   solved densely.
 //! - [`AutoDiff`]: Φ_q by forward-mode automatic differentiation (num-dual's `Dual64`) of the
 //!   scene's Φ, evaluated from its IR by the interpreter's tape over dual numbers, solved densely.
-//! - [`Method::Interpreted`]: `mechgen_cli::Interpreted`, the same plan as the generated code
+//! - [`Method::Interpreted`]: `mechgen_interp::Interpreted`, the same plan as the generated code
 //!   with everything evaluated from the IR, as a run-time (non-generated) library would do.
 //!
 //! The wrappers take ν and γ (and the initial guess, names and parameters) from the generated
@@ -107,7 +107,7 @@ impl Method {
                  (n passes; no heap use per call); ν and γ generated."
             }
             Method::Interpreted => {
-                "`mechgen_cli::Interpreted`: the generated code's plan, with every expression \
+                "`mechgen_interp::Interpreted`: the generated code's plan, with every expression \
                  evaluated from the IR at run time, as a non-generated library would \
                  (dynamically sized: heap vectors)."
             }

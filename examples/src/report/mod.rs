@@ -23,7 +23,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
-use mechgen_cli::Interpreted;
+use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::{Const, DefaultAllocator};
 use mechgen_runtime::{Accelerations, Dense, Mechanism, SolveError, Storage, Structured};
 
