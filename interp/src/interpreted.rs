@@ -10,11 +10,9 @@
 use std::cell::{Cell, RefCell};
 
 use mechgen::Scene;
-use mechgen::factor::Factorization;
 use mechgen::interpret::{Inputs, Tape};
+use mechgen::kernels::{self, Buffer, Method};
 use mechgen::kinematics::LengthScale;
-use mechgen::reactions::ForceStage;
-use mechgen::structure::{self, Phase, Plan};
 use mechgen::{geometry, physics};
 use mechgen_runtime::first_load_fault;
 use mechgen_runtime::nalgebra::Dyn;
@@ -48,8 +46,8 @@ pub struct Interpreted {
     /// and how many values that is.
     load_witnesses: (Tape, usize),
     reaction_names: Vec<String>,
-    /// The markers' values: the textbook tape, the same reading the trig cache, and names.
-    markers: (Tape, Tape),
+    /// The markers' values (the textbook tape) and their names.
+    markers: Tape,
     marker_names: Vec<String>,
     outputs: Outputs,
     /// Structural non-zeros of Φ_q, in the order the Jacobian tape produces them.
@@ -68,171 +66,74 @@ pub struct Interpreted {
     branch_names: Vec<String>,
     /// Every name, `'static` for the errors the solver returns (interned, see `names`).
     names: &'static Names,
-    /// One tape per branch invariant (its signed value), and the same reading the trig cache.
+    /// One tape per branch invariant (its signed value).
     branches: Vec<Tape>,
-    cached_branches: Vec<Tape>,
-    /// The solve plan, stage by stage, and the earlier stages each reads.
-    stages: Vec<PlanStage>,
-    reads: Vec<Vec<usize>>,
-    /// Workspace sizes: largest block, most value slots, trig cache, force solve.
-    largest: (usize, usize, usize, usize),
+    /// The plan's kernels as tapes, behind the `Structured` methods.
+    plan: PlanTapes,
     /// Tape slots and output values, reused by every call (evaluation is `&self`).
     scratch: RefCell<Scratch>,
     /// Block Jacobian evaluations so far: the unit of a solve's work, which fuzzing bounds.
     evaluations: Cell<u64>,
 }
 
-/// One stage of the plan, with its tapes.
+/// A kernel of the plan as a tape, with where its values go.
 #[derive(Debug, Clone)]
-enum PlanStage {
-    Explicit {
-        equations: Vec<usize>,
-        coordinates: Vec<usize>,
-        /// Positions, velocities, accelerations (the latter two if computed).
-        levels: [Option<Tape>; 3],
-        /// The sines and cosines the stage caches, and where.
-        trig: Option<(Tape, Vec<usize>)>,
-        /// The multipliers of its equations (force solve).
-        multipliers: Option<Tape>,
-    },
-    Block {
-        equations: Vec<usize>,
-        coordinates: Vec<usize>,
-        pattern: Vec<(usize, usize)>,
-        slots: usize,
-        /// Residuals, then Jacobian values.
-        jacobian: Tape,
-        factorization: Option<Factorization>,
-        /// The slot of each static pivot (empty without a factorisation).
-        pivots: Vec<usize>,
-        velocity_rhs: Option<Tape>,
-        acceleration_rhs: Option<Tape>,
-        trig: Option<(Tape, Vec<usize>)>,
-        /// The force solve's right-hand side.
-        force_rhs: Option<Tape>,
-    },
+struct Compiled {
+    tape: Tape,
+    outputs: Vec<(Buffer, usize)>,
 }
 
-impl PlanStage {
-    /// Stage `s` of `plan` (and of the force solve's plan `forces`), its tapes reading the trig
-    /// cache as the generated kernels do.
-    fn new(
-        arena: &mechgen::expr::Arena,
-        plan: &Plan,
-        forces: Option<&ForceStage>,
-        s: usize,
-    ) -> Self {
-        let tape = |roots: &[mechgen::expr::Id], phase: Phase| {
-            Tape::with_inputs(arena, roots, &plan.trig.reads(arena, roots, s, phase))
-        };
-        let force_tape = |kind_matches: Option<&Vec<mechgen::expr::Id>>| {
-            kind_matches.map(|roots| tape(roots, Phase::Final))
-        };
-        let fills: Vec<usize> = plan.trig.fills(s).collect();
-        let trig = (!fills.is_empty()).then(|| {
-            let roots: Vec<_> = fills
-                .iter()
-                .flat_map(|&m| {
-                    let (sin, cos) = plan.trig.nodes[m];
-                    [sin, cos]
-                })
-                .collect();
-            let slots = fills.iter().flat_map(|&m| [2 * m, 2 * m + 1]).collect();
-            (tape(&roots, Phase::Positions), slots)
-        });
-        match &plan.stages[s] {
-            structure::Stage::Explicit(assignments) => {
-                let level = |level: fn(&structure::Assignment) -> Option<mechgen::expr::Id>,
-                             phase| {
-                    let ids: Option<Vec<_>> = assignments.iter().map(level).collect();
-                    ids.map(|ids| tape(&ids, phase))
-                };
-                PlanStage::Explicit {
-                    equations: assignments.iter().map(|a| a.equation).collect(),
-                    coordinates: assignments.iter().map(|a| a.coordinate).collect(),
-                    levels: [
-                        level(|a| Some(a.position), Phase::Positions),
-                        level(|a| a.velocity, Phase::After),
-                        level(|a| a.acceleration, Phase::After),
-                    ],
-                    trig,
-                    multipliers: force_tape(match forces {
-                        Some(ForceStage::Explicit(values)) => Some(values),
-                        _ => None,
-                    }),
-                }
-            }
-            structure::Stage::Block(block) => {
-                let roots: Vec<_> = block
-                    .residuals
-                    .iter()
-                    .copied()
-                    .chain(block.entries.iter().map(|e| e.2))
-                    .collect();
-                PlanStage::Block {
-                    equations: block.equations.clone(),
-                    coordinates: block.coordinates.clone(),
-                    pattern: block.entries.iter().map(|&(r, c, _)| (r, c)).collect(),
-                    slots: block.slots(),
-                    jacobian: tape(&roots, Phase::Positions),
-                    factorization: block.factorization.clone(),
-                    pivots: block
-                        .factorization
-                        .as_ref()
-                        .map(Factorization::pivots)
-                        .unwrap_or_default(),
-                    velocity_rhs: block.velocity_rhs.as_deref().map(|v| tape(v, Phase::After)),
-                    acceleration_rhs: block
-                        .acceleration_rhs
-                        .as_deref()
-                        .map(|v| tape(v, Phase::After)),
-                    trig,
-                    force_rhs: force_tape(match forces {
-                        Some(ForceStage::Block(values)) => Some(values),
-                        _ => None,
-                    }),
-                }
-            }
+impl Compiled {
+    fn new(arena: &mechgen::expr::Arena, kernel: &kernels::Kernel) -> Self {
+        Compiled {
+            tape: Tape::with_inputs(arena, &kernel.roots, &kernel.cached),
+            outputs: kernel.outputs.clone(),
         }
+    }
+}
+
+/// The scene's kernel list (`mechgen::kernels`) compiled: the `Structured` methods look up
+/// the kernel of a stage and method in a table, where generated code has a `match`.
+#[derive(Debug, Clone)]
+struct PlanTapes {
+    /// The kernel list: the stage table, the static LUs, the workspace's sizes.
+    list: kernels::Kernels,
+    /// `dispatch[stage][method as usize]`: the stage's kernel of that method in `kernels`.
+    dispatch: Vec<[Option<usize>; Method::ALL.len()]>,
+    kernels: Vec<Compiled>,
+    /// The markers and the branch invariants at the solved state, reading the trig cache.
+    markers: Option<Compiled>,
+    branches: Vec<Compiled>,
+}
+
+impl PlanTapes {
+    fn new(arena: &mechgen::expr::Arena, list: &kernels::Kernels) -> Self {
+        let mut dispatch = vec![[None; Method::ALL.len()]; list.shapes.len()];
+        for (k, kernel) in list.stages.iter().enumerate() {
+            dispatch[kernel.stage][kernel.method as usize] = Some(k);
+        }
+        let compile = |kernel: &kernels::Kernel| Compiled::new(arena, kernel);
+        PlanTapes {
+            dispatch,
+            kernels: list.stages.iter().map(|k| compile(&k.kernel)).collect(),
+            markers: list.markers.as_ref().map(compile),
+            branches: list.branches.iter().map(compile).collect(),
+            list: list.clone(),
+        }
+    }
+
+    /// Stage `stage`'s kernel of `method`, if it has one.
+    fn kernel(&self, stage: usize, method: Method) -> Option<&Compiled> {
+        let k = (*self.dispatch.get(stage)?)[method as usize]?;
+        self.kernels.get(k)
     }
 
     fn tapes(&self) -> impl Iterator<Item = &Tape> {
-        let (levels, block, trig): (&[Option<Tape>], [Option<&Tape>; 4], _) = match self {
-            PlanStage::Explicit {
-                levels,
-                trig,
-                multipliers,
-                ..
-            } => (&levels[..], [multipliers.as_ref(), None, None, None], trig),
-            PlanStage::Block {
-                jacobian,
-                velocity_rhs,
-                acceleration_rhs,
-                trig,
-                force_rhs,
-                ..
-            } => (
-                &[][..],
-                [
-                    Some(jacobian),
-                    velocity_rhs.as_ref(),
-                    acceleration_rhs.as_ref(),
-                    force_rhs.as_ref(),
-                ],
-                trig,
-            ),
-        };
-        levels
+        self.kernels
             .iter()
-            .flatten()
-            .chain(block.into_iter().flatten())
-            .chain(trig.iter().map(|(tape, _)| tape))
-    }
-
-    fn trig(&self) -> Option<&(Tape, Vec<usize>)> {
-        match self {
-            PlanStage::Explicit { trig, .. } | PlanStage::Block { trig, .. } => trig.as_ref(),
-        }
+            .chain(&self.markers)
+            .chain(&self.branches)
+            .map(|k| &k.tape)
     }
 }
 
@@ -278,48 +179,24 @@ impl Interpreted {
             .iter()
             .map(|&b| Tape::new(arena, &[b]))
             .collect();
-        let plan: &Plan = &scene.plan;
-        let force_stages = scene.forces.as_ref().map(|f| &f.stages);
-        let stages: Vec<PlanStage> = (0..plan.stages.len())
-            .map(|s| PlanStage::new(arena, plan, force_stages.and_then(|f| f.get(s)), s))
-            .collect();
+        let plan = PlanTapes::new(arena, &scene.kernels);
         let forces = scene.forces.as_ref().map(|f| {
             (
                 Tape::new(arena, &f.generalized),
                 Tape::new(arena, &f.reactions),
             )
         });
-        let cached_markers = {
-            let reads = plan
-                .trig
-                .reads(arena, &kin.markers, plan.stages.len(), Phase::Final);
-            Tape::with_inputs(arena, &kin.markers, &reads)
-        };
-        let markers = (Tape::new(arena, &kin.markers), cached_markers);
+        let markers = Tape::new(arena, &kin.markers);
         let load_witnesses = Tape::new(arena, &scene.load_witnesses);
-        let force_storage = scene.forces.as_ref().map_or(0, |_| {
-            model.dim() + plan.blocks().map(structure::Block::slots).sum::<usize>()
-        });
-        let cached_branches: Vec<Tape> = kin
-            .branches
-            .iter()
-            .map(|&b| {
-                let cached = plan
-                    .trig
-                    .reads(arena, &[b], plan.stages.len(), Phase::Positions);
-                Tape::with_inputs(arena, &[b], &cached)
-            })
-            .collect();
         let slots = tapes
             .iter()
             .chain(&nu)
             .chain(&gamma)
             .chain(forces.iter().flat_map(|(f, r)| [f, r]))
-            .chain([&markers.0, &markers.1, &load_witnesses])
+            .chain([&markers, &load_witnesses])
             .chain([&lengths, &geometry_values, &physics_values])
             .chain(&branches)
-            .chain(&cached_branches)
-            .chain(stages.iter().flat_map(PlanStage::tapes))
+            .chain(plan.tapes())
             .map(Tape::len)
             .max()
             .unwrap_or(0);
@@ -329,7 +206,13 @@ impl Interpreted {
             .max(kin.length_scale.dependent.len())
             .max(kin.geometry.len())
             .max(kin.physics.len())
-            .max(plan.largest_block() + plan.largest_slots())
+            .max(
+                plan.kernels
+                    .iter()
+                    .map(|k| k.outputs.len())
+                    .max()
+                    .unwrap_or(0),
+            )
             .max(kin.markers.len())
             .max(scene.load_witnesses.len())
             .max(1);
@@ -379,15 +262,7 @@ impl Interpreted {
                 model.loads.iter().map(|l| l.name.clone()).collect(),
             ]),
             branches,
-            cached_branches,
-            stages,
-            reads: plan.reads.clone(),
-            largest: (
-                plan.largest_block(),
-                plan.largest_slots(),
-                plan.trig.len(),
-                force_storage,
-            ),
+            plan,
             evaluations: Cell::new(0),
             scratch: RefCell::new(Scratch {
                 slots: vec![0.0; slots],
@@ -491,7 +366,7 @@ impl Mechanism for Interpreted {
         out: &mut Vec<f64>,
     ) {
         let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), &[], t);
-        self.run(&self.markers.0, inputs, |v| {
+        self.run(&self.markers, inputs, |v| {
             out.iter_mut().zip(v).for_each(|(o, v)| *o = *v);
         });
     }
@@ -736,45 +611,36 @@ impl Structured for Interpreted {
     type Workspace = VecBuffers;
 
     fn workspace(&self) -> VecBuffers {
+        let sizes = &self.plan.list.sizes;
         VecBuffers::new(
-            self.largest.0,
-            self.largest.1,
-            self.stages.len().max(1),
-            self.coordinates.len(),
-            self.largest.2,
-            self.largest.3,
+            sizes.largest_block,
+            sizes.largest_slots,
+            sizes.stages,
+            sizes.coordinates,
+            sizes.trig,
+            sizes.forces.unwrap_or(0),
         )
     }
 
     fn stage_count(&self) -> usize {
-        self.stages.len()
+        self.plan.list.shapes.len()
     }
 
     fn stage(&self, index: usize) -> Option<Stage<'_>> {
-        let reads = self.reads.get(index)?;
-        Some(match self.stages.get(index)? {
-            PlanStage::Explicit {
-                equations,
-                coordinates,
-                ..
-            } => Stage::Explicit {
+        let shape = self.plan.list.shapes.get(index)?;
+        let (equations, coordinates, reads) = (&shape.equations, &shape.coordinates, &shape.reads);
+        Some(match &shape.block {
+            None => Stage::Explicit {
                 equations,
                 coordinates,
                 reads,
             },
-            PlanStage::Block {
+            Some(block) => Stage::Block(Block {
                 equations,
                 coordinates,
-                pattern,
-                slots,
-                pivots,
-                ..
-            } => Stage::Block(Block {
-                equations,
-                coordinates,
-                pattern: Pattern::Sparse(pattern),
-                slots: *slots,
-                pivots,
+                pattern: Pattern::Sparse(&block.pattern),
+                slots: block.slots,
+                pivots: &block.pivots,
                 reads,
             }),
         })
@@ -782,8 +648,8 @@ impl Structured for Interpreted {
 
     fn assign_positions(&self, stage: usize, q: &mut Vector<Dyn>, trig: &[f64], t: f64) {
         let inputs = self.inputs_with(q.as_slice(), &[], &[], trig, t);
-        if self.evaluate_level(stage, 0, inputs) {
-            self.write_level(stage, q);
+        if let Some(kernel) = self.evaluate(stage, Method::Positions, inputs) {
+            self.scatter(kernel, Buffer::Q, q.as_mut_slice());
         }
     }
 
@@ -796,8 +662,8 @@ impl Structured for Interpreted {
         t: f64,
     ) {
         let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), &[], trig, t);
-        if self.evaluate_level(stage, 1, inputs) {
-            self.write_level(stage, qd);
+        if let Some(kernel) = self.evaluate(stage, Method::Velocities, inputs) {
+            self.scatter(kernel, Buffer::Qd, qd.as_mut_slice());
         }
     }
 
@@ -811,8 +677,8 @@ impl Structured for Interpreted {
         t: f64,
     ) {
         let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t);
-        if self.evaluate_level(stage, 2, inputs) {
-            self.write_level(stage, qdd);
+        if let Some(kernel) = self.evaluate(stage, Method::Accelerations, inputs) {
+            self.scatter(kernel, Buffer::Qdd, qdd.as_mut_slice());
         }
     }
 
@@ -826,36 +692,27 @@ impl Structured for Interpreted {
         values: &mut [f64],
     ) {
         self.evaluations.set(self.evaluations.get() + 1);
-        if let Some(PlanStage::Block {
-            jacobian, pattern, ..
-        }) = self.stages.get(stage)
-        {
-            let inputs = self.inputs_with(q.as_slice(), &[], &[], trig, t);
-            self.run(jacobian, inputs, |v| {
-                let (residuals, entries) = v.split_at(phi.len());
-                phi.copy_from_slice(residuals);
-                values[..pattern.len()].copy_from_slice(&entries[..pattern.len()]);
-            });
+        let inputs = self.inputs_with(q.as_slice(), &[], &[], trig, t);
+        if let Some(kernel) = self.evaluate(stage, Method::Jacobian, inputs) {
+            self.scatter(kernel, Buffer::Phi, phi);
+            self.scatter(kernel, Buffer::Values, values);
         }
     }
 
     fn fill_trig(&self, stage: usize, q: &Vector<Dyn>, trig: &mut [f64]) {
-        if let Some((tape, slots)) = self.stages.get(stage).and_then(PlanStage::trig) {
-            self.run(tape, self.inputs(q.as_slice(), &[], 0.0), |v| {
-                for (&slot, &value) in slots.iter().zip(v) {
-                    trig[slot] = value;
-                }
-            });
+        let inputs = self.inputs(q.as_slice(), &[], 0.0);
+        if let Some(kernel) = self.evaluate(stage, Method::FillTrig, inputs) {
+            self.scatter(kernel, Buffer::Trig, trig);
         }
     }
 
     fn branch(&self, index: usize, q: &Vector<Dyn>, trig: &[f64]) -> f64 {
-        let Some(tape) = self.cached_branches.get(index) else {
+        let Some(kernel) = self.plan.branches.get(index) else {
             return f64::NAN;
         };
         let mut value = f64::NAN;
         let inputs = self.inputs_with(q.as_slice(), &[], &[], trig, 0.0);
-        self.run(tape, inputs, |v| {
+        self.run(&kernel.tape, inputs, |v| {
             value = v.first().copied().unwrap_or(f64::NAN)
         });
         value
@@ -870,27 +727,30 @@ impl Structured for Interpreted {
         t: f64,
         out: &mut Vec<f64>,
     ) {
+        let Some(kernel) = &self.plan.markers else {
+            return;
+        };
         let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t);
-        self.run(&self.markers.1, inputs, |v| {
+        self.run(&kernel.tape, inputs, |v| {
             out.iter_mut().zip(v).for_each(|(o, v)| *o = *v);
         });
     }
 
     fn factor(&self, stage: usize, values: &mut [f64], tiny: f64, limit: f64) -> Result<(), usize> {
-        match self.factorization(stage) {
+        match self.plan.list.factorization(stage) {
             Some(f) if values.len() >= f.slots => f.factor(values, tiny, limit),
             _ => Err(0),
         }
     }
 
     fn solve(&self, stage: usize, values: &[f64], x: &mut [f64]) {
-        if let Some(f) = self.factorization(stage) {
+        if let Some(f) = self.plan.list.factorization(stage) {
             f.solve(values, x);
         }
     }
 
     fn solve_transpose(&self, stage: usize, values: &[f64], x: &mut [f64]) {
-        if let Some(f) = self.factorization(stage) {
+        if let Some(f) = self.plan.list.factorization(stage) {
             f.solve_transpose(values, x);
         }
     }
@@ -904,15 +764,10 @@ impl Structured for Interpreted {
         t: f64,
         out: &mut [f64],
     ) {
-        match self.stages.get(stage) {
-            Some(PlanStage::Block {
-                velocity_rhs: Some(tape),
-                ..
-            }) => {
-                let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), &[], trig, t);
-                self.run(tape, inputs, |v| out.copy_from_slice(&v[..out.len()]));
-            }
-            _ => out.fill(f64::NAN),
+        let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), &[], trig, t);
+        match self.evaluate(stage, Method::VelocityRhs, inputs) {
+            Some(kernel) => self.scatter(kernel, Buffer::Out, out),
+            None => out.fill(f64::NAN),
         }
     }
 
@@ -926,15 +781,10 @@ impl Structured for Interpreted {
         t: f64,
         out: &mut [f64],
     ) {
-        match self.stages.get(stage) {
-            Some(PlanStage::Block {
-                acceleration_rhs: Some(tape),
-                ..
-            }) => {
-                let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t);
-                self.run(tape, inputs, |v| out.copy_from_slice(&v[..out.len()]));
-            }
-            _ => out.fill(f64::NAN),
+        let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t);
+        match self.evaluate(stage, Method::AccelerationRhs, inputs) {
+            Some(kernel) => self.scatter(kernel, Buffer::Out, out),
+            None => out.fill(f64::NAN),
         }
     }
 
@@ -948,28 +798,20 @@ impl Structured for Interpreted {
         lambda: &mut [f64],
         t: f64,
     ) {
-        let Some(PlanStage::Explicit {
-            equations,
-            multipliers,
-            ..
-        }) = self.stages.get(stage)
-        else {
-            return;
-        };
         let inputs = Inputs {
             lambda,
             ..self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t)
         };
-        // Every multiplier is computed before any is written, as generated code loads first.
-        let mut scratch = self.scratch.borrow_mut();
-        let Scratch { slots, values } = &mut *scratch;
-        match multipliers {
-            Some(tape) => tape.eval(inputs, slots, values),
-            None => values.fill(f64::NAN),
-        }
-        for (&e, &v) in equations.iter().zip(values.iter()) {
-            if let Some(l) = lambda.get_mut(e) {
-                *l = v;
+        match self.evaluate(stage, Method::Multipliers, inputs) {
+            Some(kernel) => self.scatter(kernel, Buffer::Lambda, lambda),
+            // As the trait's default: the stage's multipliers are unknown.
+            None => {
+                let equations = self.plan.list.shapes.get(stage).map(|s| &s.equations);
+                for &e in equations.into_iter().flatten() {
+                    if let Some(l) = lambda.get_mut(e) {
+                        *l = f64::NAN;
+                    }
+                }
             }
         }
     }
@@ -985,53 +827,36 @@ impl Structured for Interpreted {
         t: f64,
         out: &mut [f64],
     ) {
-        match self.stages.get(stage) {
-            Some(PlanStage::Block {
-                force_rhs: Some(tape),
-                ..
-            }) => {
-                let inputs = Inputs {
-                    lambda,
-                    ..self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t)
-                };
-                self.run(tape, inputs, |v| out.copy_from_slice(&v[..out.len()]));
-            }
-            _ => out.fill(f64::NAN),
+        let inputs = Inputs {
+            lambda,
+            ..self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t)
+        };
+        match self.evaluate(stage, Method::ForceRhs, inputs) {
+            Some(kernel) => self.scatter(kernel, Buffer::Out, out),
+            None => out.fill(f64::NAN),
         }
     }
 }
 
 impl Interpreted {
-    fn factorization(&self, stage: usize) -> Option<&Factorization> {
-        match self.stages.get(stage)? {
-            PlanStage::Block { factorization, .. } => factorization.as_ref(),
-            PlanStage::Explicit { .. } => None,
-        }
-    }
-
-    /// Evaluates level `level` (positions, velocities, accelerations) of an explicit stage into
-    /// the scratch values; false if the stage has no such level. Every value is computed
-    /// before [`Interpreted::write_level`] writes any back, as generated code loads its inputs
-    /// first.
-    fn evaluate_level(&self, stage: usize, level: usize, inputs: Inputs<'_>) -> bool {
-        let Some(PlanStage::Explicit { levels, .. }) = self.stages.get(stage) else {
-            return false;
-        };
-        let Some(tape) = &levels[level] else {
-            return false;
-        };
+    /// Evaluates stage `stage`'s kernel of `method` into the scratch values, or returns `None`
+    /// when the stage has no such kernel. Every value is computed before
+    /// [`Interpreted::scatter`] writes any back, as generated code loads its inputs first.
+    fn evaluate(&self, stage: usize, method: Method, inputs: Inputs<'_>) -> Option<&Compiled> {
+        let kernel = self.plan.kernel(stage, method)?;
         let mut scratch = self.scratch.borrow_mut();
         let Scratch { slots, values } = &mut *scratch;
-        tape.eval(inputs, slots, values);
-        true
+        kernel.tape.eval(inputs, slots, values);
+        Some(kernel)
     }
 
-    /// Writes the values of [`Interpreted::evaluate_level`] to the stage's coordinates of `out`.
-    fn write_level(&self, stage: usize, out: &mut Vector<Dyn>) {
-        if let Some(PlanStage::Explicit { coordinates, .. }) = self.stages.get(stage) {
-            let scratch = self.scratch.borrow();
-            for (&c, &v) in coordinates.iter().zip(&scratch.values) {
-                out[c] = v;
+    /// Writes the values of [`Interpreted::evaluate`] that `kernel` sends to `buffer` into
+    /// `out`, at their indices.
+    fn scatter(&self, kernel: &Compiled, buffer: Buffer, out: &mut [f64]) {
+        let scratch = self.scratch.borrow();
+        for (&(b, i), &v) in kernel.outputs.iter().zip(&scratch.values) {
+            if let (true, Some(o)) = (b == buffer, out.get_mut(i)) {
+                *o = v;
             }
         }
     }

@@ -7,10 +7,13 @@
 //! an output with zeros is cleared once and only non-zeros are written.
 
 mod body;
+mod dispatch;
 mod forces;
+mod lu;
 mod markers;
 mod physics;
 mod plan;
+mod stages;
 
 use std::cell::RefCell;
 
@@ -60,7 +63,6 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
     let cx = Context {
         model: &scene.model,
         equations: scene.model.equation_names(),
-        kinematics_branches: &scene.kinematics.branches,
         forces: scene.forces.as_ref(),
         markers: &scene.kinematics.markers,
         load_witnesses: &scene.load_witnesses,
@@ -71,7 +73,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
     let parameters = cx.parameter_struct();
     let constants = cx.constants(kin);
     let mechanism = cx.mechanism_impl(kin);
-    let structured = plan::structured_impl(&cx, &scene.plan);
+    let structured = plan::structured_impl(&cx, &scene.plan, &scene.kernels);
     let accessors = cx.accessors();
     let force_accessors = cx.forces.map(|_| cx.force_accessors());
     // Split bodies' parts, collected while the functions above were generated.
