@@ -57,89 +57,86 @@ impl Method {
         Method::ForceRhs,
     ];
 
-    /// When the kernel runs, which decides the trig slots it may read: a stage's positions
-    /// (and the sines it fills) only from earlier stages, its rates also from its own, the
-    /// force solve from every stage.
+    /// The method's row of [`METHODS`].
+    pub fn info(self) -> &'static MethodInfo {
+        &METHODS[self as usize]
+    }
+
+    /// When the kernel runs: see [`MethodInfo::phase`].
     pub fn phase(self) -> Phase {
-        match self {
-            Method::Positions | Method::Jacobian | Method::FillTrig => Phase::Positions,
-            Method::Velocities
-            | Method::Accelerations
-            | Method::VelocityRhs
-            | Method::AccelerationRhs => Phase::After,
-            Method::Multipliers | Method::ForceRhs => Phase::Final,
-        }
+        self.info().phase
     }
 
-    /// The state the method's kernels may read besides the trig cache and time.
+    /// The state its kernels may read besides the trig cache and time.
     pub fn inputs(self) -> &'static [Input] {
-        match self {
-            Method::Positions | Method::Jacobian | Method::FillTrig => &[Input::Q],
-            Method::Velocities | Method::VelocityRhs => &[Input::Q, Input::Qd],
-            Method::Accelerations | Method::AccelerationRhs => &[Input::Q, Input::Qd, Input::Qdd],
-            Method::Multipliers | Method::ForceRhs => {
-                &[Input::Q, Input::Qd, Input::Qdd, Input::Lambda]
-            }
-        }
+        self.info().inputs
     }
 
-    /// The `Structured` method's name.
-    pub fn trait_method(self) -> &'static str {
-        match self {
-            Method::Positions => "assign_positions",
-            Method::Velocities => "assign_velocities",
-            Method::Accelerations => "assign_accelerations",
-            Method::Jacobian => "block_jacobian",
-            Method::VelocityRhs => "velocity_rhs",
-            Method::AccelerationRhs => "acceleration_rhs",
-            Method::FillTrig => "fill_trig",
-            Method::Multipliers => "assign_multipliers",
-            Method::ForceRhs => "force_rhs",
-        }
+    /// The buffer its kernels write (a block's Jacobian also writes [`Buffer::Phi`]).
+    pub fn target(self) -> Buffer {
+        self.info().target
     }
 
     /// The kernel's name in stage `s` (`stage_3_positions`).
     pub fn kernel_name(self, s: usize) -> String {
-        let what = match self {
-            Method::Positions => "positions",
-            Method::Velocities => "velocities",
-            Method::Accelerations => "accelerations",
-            Method::Jacobian => "jacobian",
-            Method::VelocityRhs => "velocity_rhs",
-            Method::AccelerationRhs => "acceleration_rhs",
-            Method::FillTrig => "trig",
-            Method::Multipliers => "multipliers",
-            Method::ForceRhs => "force_rhs",
-        };
-        format!("stage_{s}_{what}")
+        format!("stage_{s}_{}", self.info().suffix)
     }
+}
 
-    /// What the kernel does, for its documentation.
-    pub fn description(self) -> &'static str {
-        match self {
-            Method::Positions => "assigns the positions",
-            Method::Velocities => "assigns the velocities",
-            Method::Accelerations => "assigns the accelerations",
-            Method::Jacobian => "the block's residual and Jacobian values",
-            Method::VelocityRhs => "the block's velocity right-hand side",
-            Method::AccelerationRhs => "the block's acceleration right-hand side",
-            Method::FillTrig => "caches the sines and cosines of its angles",
-            Method::Multipliers => "assigns its equations' multipliers (force solve)",
-            Method::ForceRhs => "the block's force right-hand side",
-        }
-    }
+/// What a consumer needs to know about a [`Method`].
+#[derive(Debug)]
+pub struct MethodInfo {
+    /// The `Structured` method's name.
+    pub trait_method: &'static str,
+    /// Its kernels' names after `stage_s_`.
+    pub suffix: &'static str,
+    /// What its kernels do, for their documentation.
+    pub description: &'static str,
+    /// When it runs, which decides the trig slots it may read: a stage's positions (and the
+    /// sines it fills) only from earlier stages, its rates also from its own, the force solve
+    /// from every stage.
+    pub phase: Phase,
+    /// The state it reads besides the trig cache and time.
+    pub inputs: &'static [Input],
+    /// The buffer it writes.
+    pub target: Buffer,
+}
 
-    /// The buffer the method's kernels write (a block's Jacobian also writes [`Buffer::Phi`]).
-    pub fn target(self) -> Buffer {
-        match self {
-            Method::Positions => Buffer::Q,
-            Method::Velocities => Buffer::Qd,
-            Method::Accelerations => Buffer::Qdd,
-            Method::Jacobian => Buffer::Values,
-            Method::VelocityRhs | Method::AccelerationRhs | Method::ForceRhs => Buffer::Out,
-            Method::FillTrig => Buffer::Trig,
-            Method::Multipliers => Buffer::Lambda,
-        }
+const POSITIONS: &[Input] = &[Input::Q];
+const VELOCITIES: &[Input] = &[Input::Q, Input::Qd];
+const ACCELERATIONS: &[Input] = &[Input::Q, Input::Qd, Input::Qdd];
+const FORCES: &[Input] = &[Input::Q, Input::Qd, Input::Qdd, Input::Lambda];
+
+/// The methods' facts, in [`Method::ALL`] order.
+#[rustfmt::skip]
+const METHODS: [MethodInfo; 9] = [
+    //   trait method            kernel suffix       description                                          phase             reads          writes
+    info("assign_positions",     "positions",        "assigns the positions",                             Phase::Positions, POSITIONS,     Buffer::Q),
+    info("assign_velocities",    "velocities",       "assigns the velocities",                            Phase::After,     VELOCITIES,    Buffer::Qd),
+    info("assign_accelerations", "accelerations",    "assigns the accelerations",                         Phase::After,     ACCELERATIONS, Buffer::Qdd),
+    info("block_jacobian",       "jacobian",         "the block's residual and Jacobian values",          Phase::Positions, POSITIONS,     Buffer::Values),
+    info("velocity_rhs",         "velocity_rhs",     "the block's velocity right-hand side",              Phase::After,     VELOCITIES,    Buffer::Out),
+    info("acceleration_rhs",     "acceleration_rhs", "the block's acceleration right-hand side",          Phase::After,     ACCELERATIONS, Buffer::Out),
+    info("fill_trig",            "trig",             "caches the sines and cosines of its angles",        Phase::Positions, POSITIONS,     Buffer::Trig),
+    info("assign_multipliers",   "multipliers",      "assigns its equations' multipliers (force solve)",  Phase::Final,     FORCES,        Buffer::Lambda),
+    info("force_rhs",            "force_rhs",        "the block's force right-hand side",                 Phase::Final,     FORCES,        Buffer::Out),
+];
+
+const fn info(
+    trait_method: &'static str,
+    suffix: &'static str,
+    description: &'static str,
+    phase: Phase,
+    inputs: &'static [Input],
+    target: Buffer,
+) -> MethodInfo {
+    MethodInfo {
+        trait_method,
+        suffix,
+        description,
+        phase,
+        inputs,
+        target,
     }
 }
 
@@ -561,6 +558,20 @@ mod tests {
         driver d1: angle(c1) = t;
         driver d2: angle(c2) = 2 * t;
     }";
+
+    /// The facts table is indexed by the method: a row out of place would give a kernel
+    /// another method's phase, inputs or name.
+    #[test]
+    fn the_method_table_is_in_method_order() {
+        for (i, method) in Method::ALL.into_iter().enumerate() {
+            assert_eq!(method as usize, i);
+            let debug = format!("{method:?}").to_lowercase();
+            let info = method.info();
+            let named = info.trait_method.replace('_', "");
+            let found = named.contains(&debug) || debug.contains(info.suffix.trim_end_matches('s'));
+            assert!(found, "{method:?} has the row of {}", info.trait_method);
+        }
+    }
 
     /// A kernel of stage `s` reads a cached sine only once it is filled: positions from
     /// earlier stages, rates from earlier stages and its own, the force solve from any.

@@ -110,3 +110,74 @@ impl Dispatch {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn render(dispatch: &Dispatch, required: bool) -> String {
+        let params = [
+            ("q", quote!(&Q)),
+            ("trig", quote!(&[f64])),
+            ("out", quote!(&mut [f64])),
+        ];
+        let eight = idx(8);
+        let views = [("trig", &eight)];
+        dispatch
+            .method("m", &params, None, required, &views)
+            .to_string()
+    }
+
+    #[test]
+    fn a_method_no_stage_needs_is_left_to_the_default_unless_required() {
+        let empty = Dispatch::default();
+        assert_eq!(render(&empty, false), "");
+        let required = render(&empty, true);
+        assert!(
+            required.starts_with("fn m (& self , _stage : usize , _q : & Q"),
+            "{required}"
+        );
+        assert!(
+            required.contains("_trig") && required.contains("_out"),
+            "{required}"
+        );
+    }
+
+    #[test]
+    fn one_stage_is_an_if_and_unread_parameters_are_underscored() {
+        let mut one = Dispatch::default();
+        one.push(3, quote!(self.k(q, out);), &["q", "out"]);
+        let code = render(&one, false);
+        assert!(
+            code.contains("if stage == 3 { self . k (q , out) ; }"),
+            "{code}"
+        );
+        assert!(
+            code.contains("_trig : & [f64]") && !code.contains("match"),
+            "{code}"
+        );
+        assert!(
+            !code.contains("first_chunk"),
+            "no view of an unread trig: {code}"
+        );
+    }
+
+    #[test]
+    fn several_stages_match_and_a_read_view_poisons_the_outputs_when_short() {
+        let mut two = Dispatch::default();
+        two.push(0, quote!(self.a(trig, out);), &["trig", "out"]);
+        two.push(2, quote!(self.b(q);), &["q"]);
+        let code = render(&two, false);
+        assert!(code.contains("match stage { 0 =>"), "{code}");
+        assert!(
+            code.contains("2 => { self . b (q) ; } _ => { } }"),
+            "{code}"
+        );
+        assert!(
+            code.contains(
+                "trig . first_chunk :: < 8 > () else { out . fill (f64 :: NAN) ; return ; }"
+            ),
+            "{code}"
+        );
+    }
+}

@@ -112,7 +112,7 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan, kernels: &Kernels) 
 /// The trait method's name.
 fn name_of(item: Item) -> &'static str {
     match item {
-        Item::Kernels(method) => method.trait_method(),
+        Item::Kernels(method) => method.info().trait_method,
         Item::Factor => "factor",
         Item::Solve => "solve",
         Item::SolveTranspose => "solve_transpose",
@@ -221,7 +221,10 @@ fn kernel_function(cx: &Context<'_>, kernels: &Kernels, k: &StageKernel) -> (Tok
         arguments.push(*out);
     }
     let function = format_ident!("{}", name);
-    let (doc, body) = (kernel_doc(k.stage, k.method.description(), &f), &f.body);
+    let (doc, body) = (
+        kernel_doc(k.stage, k.method.info().description, &f),
+        &f.body,
+    );
     let code = quote! {
         #doc
         fn #function(&self, #(#params),*) {
