@@ -194,46 +194,26 @@ impl Mechanism for Interpreted {
     }
 
     fn check_geometry(&self) -> Result<(), GeometryFault> {
-        let mut result = Ok(());
-        if self.geometry.is_empty() {
-            return result;
-        }
-        self.run(
-            &self.textbook.geometry_values,
-            self.inputs(&[], &[], 0.0),
-            |v| {
-                result = self.geometry.iter().zip(v).try_for_each(|(c, &value)| {
-                    mechgen_runtime::check_geometry(
-                        value,
-                        requirement(c.requirement),
-                        c.equation,
-                        c.parameter,
-                    )
-                });
-            },
-        );
-        result
+        let tape = &self.textbook.geometry_values;
+        self.check_values(&self.geometry, tape, |value, c| {
+            mechgen_runtime::check_geometry(
+                value,
+                requirement(c.requirement),
+                c.subject,
+                c.parameter,
+            )
+        })
     }
 
     fn check_physics(&self) -> Result<(), PhysicsFault> {
-        let mut result = Ok(());
-        if self.physics.is_empty() {
-            return result;
-        }
-        self.run(
-            &self.textbook.physics_values,
-            self.inputs(&[], &[], 0.0),
-            |v| {
-                result = self.physics.iter().zip(v).try_for_each(|(c, &value)| {
-                    let subject = match c.subject {
-                        physics::Subject::Body(b) => Subject::Body(b),
-                        physics::Subject::Load(l) => Subject::Load(l),
-                    };
-                    check_physics(value, requirement(c.requirement), subject, c.parameter)
-                });
-            },
-        );
-        result
+        let tape = &self.textbook.physics_values;
+        self.check_values(&self.physics, tape, |value, c| {
+            let subject = match c.subject {
+                physics::Subject::Body(b) => Subject::Body(b),
+                physics::Subject::Load(l) => Subject::Load(l),
+            };
+            check_physics(value, requirement(c.requirement), subject, c.parameter)
+        })
     }
 
     fn branch_count(&self) -> usize {
@@ -361,6 +341,29 @@ impl Mechanism for Interpreted {
     fn reaction_name(&self, index: usize) -> Option<&str> {
         self.textbook.forces.as_ref()?;
         self.reaction_names.get(index).map(String::as_str)
+    }
+}
+
+impl Interpreted {
+    /// Evaluates the values of `checks` (`tape`) with the current parameters and checks each
+    /// in order with `check`, stopping at the first fault.
+    fn check_values<S, F>(
+        &self,
+        checks: &[geometry::Check<S>],
+        tape: &Tape,
+        check: impl Fn(f64, &geometry::Check<S>) -> Result<(), F>,
+    ) -> Result<(), F> {
+        let mut result = Ok(());
+        if checks.is_empty() {
+            return result;
+        }
+        self.run(tape, self.inputs(&[], &[], 0.0), |v| {
+            result = checks
+                .iter()
+                .zip(v)
+                .try_for_each(|(c, &value)| check(value, c));
+        });
+        result
     }
 }
 
