@@ -57,7 +57,7 @@ impl Method {
         Method::ForceRhs,
     ];
 
-    /// The method's row of [`METHODS`].
+    /// The method's facts (one row of the table in this module).
     pub fn info(self) -> &'static MethodInfo {
         &METHODS[self as usize]
     }
