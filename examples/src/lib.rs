@@ -12,3 +12,4 @@ pub mod plot;
 pub mod report;
 pub mod scenes;
 pub mod stability;
+pub mod written_out;

@@ -57,15 +57,17 @@ impl Requirement {
     }
 }
 
-/// One parameter-dependent geometric value to check at run time.
+/// One parameter-dependent value to check at run time: geometry (here, `S` the first equation
+/// of the constraint it belongs to, the first constraint's if several share it) or a mass
+/// property or load constant ([`crate::physics`], `S` the body or load).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Check {
+pub struct Check<S = usize> {
     /// The value, an expression in parameters.
     pub value: Id,
     /// Its rule.
     pub requirement: Requirement,
-    /// The first equation of the constraint it belongs to (the first one, if several share it).
-    pub equation: usize,
+    /// What it belongs to, which the runtime's fault names.
+    pub subject: S,
     /// The lowest-indexed parameter it reads.
     pub parameter: usize,
 }
@@ -83,7 +85,7 @@ pub fn checks(model: &Model) -> Vec<Check> {
                 checks.push(Check {
                     value,
                     requirement,
-                    equation,
+                    subject: equation,
                     parameter,
                 });
             }
@@ -165,7 +167,7 @@ mod tests {
         );
         let found: Vec<(Requirement, usize, usize)> = checks
             .iter()
-            .map(|c| (c.requirement, c.equation, c.parameter))
+            .map(|c| (c.requirement, c.subject, c.parameter))
             .collect();
         // Ground equations 0..3, pivot 3..5, tie 5, guide 6..8: `rod + offset` reads parameters
         // 0 and 1 and names the lower; the driver's value depends on t and is not geometry.

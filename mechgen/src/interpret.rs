@@ -229,6 +229,11 @@ impl Tape {
         vec![S::from_f64(0.0); self.ops.len()]
     }
 
+    /// Number of outputs: the values [`Tape::eval`] writes.
+    pub fn output_count(&self) -> usize {
+        self.outputs.len()
+    }
+
     /// Number of instructions.
     pub fn len(&self) -> usize {
         self.ops.len()

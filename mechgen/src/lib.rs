@@ -26,6 +26,7 @@ mod frames;
 pub mod geometry;
 pub mod graph;
 pub mod interpret;
+pub mod kernels;
 pub mod kinematics;
 pub mod limits;
 pub mod markers;
@@ -60,6 +61,8 @@ pub struct Scene {
     /// The force solve, for a scene that computes forces: the generalised forces, the plan's
     /// stages in reverse, the reported reactions.
     pub forces: Option<reactions::Forces>,
+    /// Every kernel of the plan and the force solve, as the emitter and the interpreter run them.
+    pub kernels: kernels::Kernels,
     /// For a scene that computes forces, two values per load that name the load making F
     /// non-finite (`dynamics::load_witnesses`); empty otherwise.
     pub load_witnesses: Vec<expr::Id>,
@@ -116,6 +119,13 @@ impl Scene {
             plan.cache_final_reads(&mut model.arena, n, &reads);
             forces
         });
+        let kernels = kernels::list(
+            &model.arena,
+            &plan,
+            forces.as_ref(),
+            &kinematics.markers,
+            &kinematics.branches,
+        );
         let load_witnesses = match forces {
             Some(_) => dynamics::load_witnesses(&mut model),
             None => Vec::new(),
@@ -125,6 +135,7 @@ impl Scene {
             kinematics,
             plan,
             forces,
+            kernels,
             load_witnesses,
         }
     }

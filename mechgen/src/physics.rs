@@ -24,17 +24,7 @@ pub enum Subject {
 }
 
 /// One parameter-dependent mass property or load constant to check at run time.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Check {
-    /// The value, an expression in parameters.
-    pub value: crate::expr::Id,
-    /// Its rule.
-    pub requirement: Requirement,
-    /// The body or load it belongs to.
-    pub subject: Subject,
-    /// The lowest-indexed parameter it reads.
-    pub parameter: usize,
-}
+pub type Check = crate::geometry::Check<Subject>;
 
 /// Every parameter-dependent mass property and load constant of `model`, each once per body or
 /// load, in declaration order (bodies, then loads).

@@ -99,8 +99,6 @@ pub(super) struct Context<'a> {
     pub model: &'a Model,
     /// The model's equation names, for naming multipliers (`lambda_crank_pin_x`).
     pub equations: Vec<String>,
-    /// The branch invariants' values (from the kinematics).
-    pub kinematics_branches: &'a [Id],
     /// The force solve, for a scene that computes forces.
     pub forces: Option<&'a crate::reactions::Forces>,
     /// The markers' values (from the kinematics).

@@ -10,12 +10,9 @@ use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
 use super::body::{Context, computed};
-use super::plan::Kernels;
 use super::{idx, signature_with};
-use crate::expr::Id;
 use crate::model::ConstraintKind;
-use crate::reactions::{ForceStage, Forces};
-use crate::structure::{Phase, Stage};
+use crate::reactions::Forces;
 
 impl Context<'_> {
     /// `generalized_forces`, `reactions` and `reaction_name` for `impl Mechanism`.
@@ -278,75 +275,5 @@ impl Context<'_> {
             .bodies
             .get(body)
             .map_or_else(String::new, |b| b.name.to_string())
-    }
-}
-
-impl Kernels<'_> {
-    /// Stage `s`'s kernel of the force solve: an explicit stage's multipliers, or a block's
-    /// force right-hand side. Both run after the whole forward sweep (every trig slot filled).
-    pub(super) fn force_stage(
-        &mut self,
-        cx: &Context<'_>,
-        s: usize,
-        stage: &Stage,
-        force: &ForceStage,
-    ) {
-        let n = idx(cx.model.dim());
-        let some = quote!(::core::option::Option::Some);
-        match (stage, force) {
-            (Stage::Explicit(assignments), ForceStage::Explicit(values)) => {
-                let outputs: Vec<(TokenStream, Id)> = assignments
-                    .iter()
-                    .zip(values)
-                    .map(|(a, &v)| {
-                        let e = idx(a.equation);
-                        (quote!(lambda[#e]), v)
-                    })
-                    .collect();
-                let kernel = self.kernel(
-                    cx,
-                    s,
-                    Phase::Final,
-                    "assigns its equations' multipliers (force solve)",
-                    &format!("stage_{s}_multipliers"),
-                    &outputs,
-                    &["q", "qd", "qdd", "lambda"],
-                    &[("lambda", quote!(&mut [f64; #n]))],
-                );
-                let call = kernel.call();
-                self.multipliers.push(s, quote!(#call;), &kernel.arguments);
-            }
-            (Stage::Block(block), ForceStage::Block(values)) => {
-                let len = idx(block.equations.len());
-                let outputs: Vec<(TokenStream, Id)> = values
-                    .iter()
-                    .enumerate()
-                    .map(|(j, &v)| {
-                        let j = idx(j);
-                        (quote!(out[#j]), v)
-                    })
-                    .collect();
-                let kernel = self.kernel(
-                    cx,
-                    s,
-                    Phase::Final,
-                    "the block's force right-hand side",
-                    &format!("stage_{s}_force_rhs"),
-                    &outputs,
-                    &["q", "qd", "qdd", "lambda"],
-                    &[("out", quote!(&mut [f64; #len]))],
-                );
-                let call = kernel.call();
-                let arm = quote! {
-                    let #some(out) = out.first_chunk_mut::<#len>() else {
-                        out.fill(f64::NAN);
-                        return;
-                    };
-                    #call;
-                };
-                self.force_rhs.push(s, arm, &kernel.arguments);
-            }
-            _ => unreachable!("the force plan follows the kinematic plan stage for stage"),
-        }
     }
 }

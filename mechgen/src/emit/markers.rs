@@ -8,8 +8,8 @@ use quote::{format_ident, quote};
 
 use super::body::{Context, computed};
 use super::idx;
+use crate::kernels::{Kernel, Kernels};
 use crate::model::{MarkerKind, Outputs};
-use crate::structure::{Phase, Plan};
 
 impl Context<'_> {
     /// Number of marker values.
@@ -73,17 +73,19 @@ impl Context<'_> {
 
     /// The `markers` kernel of `impl Structured`: the values from the solve's trig cache
     /// (every stage has filled it by then); nothing without markers.
-    pub(super) fn markers_method(&self, values: &[crate::expr::Id], plan: &Plan) -> TokenStream {
-        if values.is_empty() {
+    pub(super) fn markers_method(&self, kernels: &Kernels) -> TokenStream {
+        let Some(Kernel {
+            roots: values,
+            cached,
+            ..
+        }) = &kernels.markers
+        else {
             return TokenStream::new();
-        }
-        let (k, trig_len) = (self.marker_count(values), idx(plan.trig.len()));
-        let cached = plan
-            .trig
-            .reads(self.arena(), values, plan.stages.len(), Phase::Final);
+        };
+        let (k, trig_len) = (self.marker_count(values), idx(kernels.sizes.trig));
         let outputs = super::vector_outputs(values, &quote!(out));
         let clear = super::clear_if_sparse(self.arena(), values, &quote!(out));
-        let f = self.function(&outputs, clear, &cached);
+        let f = self.function(&outputs, clear, cached);
         let body = f.body;
         let (q, qd, qdd, t, trig) = (&f.args.q, &f.args.qd, &f.args.qdd, &f.args.t, &f.args.trig);
         let view = (trig == "trig").then(|| {

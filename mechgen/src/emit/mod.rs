@@ -7,10 +7,13 @@
 //! an output with zeros is cleared once and only non-zeros are written.
 
 mod body;
+mod checks;
+mod dispatch;
 mod forces;
+mod lu;
 mod markers;
-mod physics;
 mod plan;
+mod stages;
 
 use std::cell::RefCell;
 
@@ -60,7 +63,6 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
     let cx = Context {
         model: &scene.model,
         equations: scene.model.equation_names(),
-        kinematics_branches: &scene.kinematics.branches,
         forces: scene.forces.as_ref(),
         markers: &scene.kinematics.markers,
         load_witnesses: &scene.load_witnesses,
@@ -71,7 +73,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
     let parameters = cx.parameter_struct();
     let constants = cx.constants(kin);
     let mechanism = cx.mechanism_impl(kin);
-    let structured = plan::structured_impl(&cx, &scene.plan);
+    let structured = plan::structured_impl(&cx, &scene.plan, &scene.kernels);
     let accessors = cx.accessors();
     let force_accessors = cx.forces.map(|_| cx.force_accessors());
     // Split bodies' parts, collected while the functions above were generated.
@@ -283,8 +285,8 @@ impl Context<'_> {
             }
         });
         let length_scale = self.length_scale(kin);
-        let check_geometry = self.check_geometry(kin);
-        let check_physics = self.check_physics(kin);
+        let check_geometry = self.check_method(&kin.geometry, checks::Checks::Geometry);
+        let check_physics = self.check_method(&kin.physics, checks::Checks::Physics);
         let branch_methods = self.branch_methods(kin);
         let equations = self.textbook_functions(kin);
         let force_methods = self.forces.map(|forces| self.force_methods(forces));
@@ -668,9 +670,9 @@ impl Context<'_> {
     }
 
     /// Statements binding each of `ids` (expressions in parameters) to a local `{prefix}{k}`,
-    /// sharing sub-expressions, and the locals' names: what `length_scale` and `check_geometry`
+    /// sharing sub-expressions, and the locals' names: what `length_scale` and the parameter checks
     /// evaluate with the current parameters.
-    fn bind_locals(&self, prefix: &str, ids: &[Id]) -> (Vec<Ident>, TokenStream) {
+    pub(super) fn bind_locals(&self, prefix: &str, ids: &[Id]) -> (Vec<Ident>, TokenStream) {
         let names: Vec<Ident> = (0..ids.len())
             .map(|k| format_ident!("{}{}", prefix, k))
             .collect();
@@ -690,46 +692,6 @@ impl Context<'_> {
             .function(&outputs, TokenStream::new(), &computed())
             .body;
         (names, quote! { #body #(#zeros)* })
-    }
-
-    /// `check_geometry` for a scene with geometry written in parameters (the runtime's default,
-    /// nothing to check, otherwise): each value evaluated with the current parameters and
-    /// checked against its rule, in declaration order ([`crate::geometry`]).
-    fn check_geometry(&self, kin: &Kinematics) -> TokenStream {
-        let checks = &kin.geometry;
-        if checks.is_empty() {
-            return TokenStream::new();
-        }
-        let values: Vec<Id> = checks.iter().map(|c| c.value).collect();
-        let (names, evaluated) = self.bind_locals("value", &values);
-        let tests = names.iter().zip(checks).map(|(name, c)| {
-            let requirement = format_ident!("{}", c.requirement.name());
-            let (equation, parameter) = (idx(c.equation), idx(c.parameter));
-            quote! {
-                ::mechgen_runtime::check_geometry(
-                    #name,
-                    ::mechgen_runtime::Requirement::#requirement,
-                    #equation,
-                    #parameter,
-                )?;
-            }
-        });
-        let doc = format!(
-            " Checks the geometry written in parameters ({} value{}) against the runtime's \
-             rules, with the current parameters.",
-            checks.len(),
-            if checks.len() == 1 { "" } else { "s" },
-        );
-        quote! {
-            #[doc = #doc]
-            fn check_geometry(
-                &self,
-            ) -> ::core::result::Result<(), ::mechgen_runtime::GeometryFault> {
-                #evaluated
-                #(#tests)*
-                ::core::result::Result::Ok(())
-            }
-        }
     }
 
     /// The spline tables of the scene's motion laws, as `SPLINE_k` constants the function

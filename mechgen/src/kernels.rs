@@ -1,0 +1,720 @@
+//! The plan's kernels as data: every decision about what the staged solve computes, made once
+//! per scene, for its two consumers.
+//!
+//! A kernel is a list of expressions (its roots) evaluated together: what it reads from the
+//! trig cache, and where each value goes. The structured solve calls kernels through the
+//! runtime's `Structured` trait, one [`Method`] per kind, dispatched on the stage index. The
+//! emitter (`emit::plan`) renders each kernel as a function and each method as a `match` over
+//! its stages; the interpreter (crate `mechgen-interp`) compiles each kernel into a tape and
+//! each method into a table lookup. Neither decides anything this module has not: which phase
+//! a level runs in (so which trig slots it may read), a block's roots (residuals, then the
+//! Jacobian's entries), which static LU a block shares, which stages have a force kernel, the
+//! workspace's sizes.
+
+use std::collections::HashMap;
+
+use crate::expr::{Arena, Id};
+use crate::factor::Factorization;
+use crate::reactions::{ForceStage, Forces};
+use crate::structure::{Phase, Plan, Stage};
+
+/// A kind of per-stage kernel: the `Structured` method that runs it.
+///
+/// The order is the order of a stage's kernels in generated code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Method {
+    /// An explicit stage's positions, written to `q` at its coordinates.
+    Positions,
+    /// An explicit stage's velocities, written to `qd`.
+    Velocities,
+    /// An explicit stage's accelerations, written to `qdd`.
+    Accelerations,
+    /// A block's residuals (to `phi`) and Jacobian values (to `values`, in pattern order).
+    Jacobian,
+    /// A block's velocity right-hand side, to `out`.
+    VelocityRhs,
+    /// A block's acceleration right-hand side, to `out`.
+    AccelerationRhs,
+    /// The sines and cosines of the angles a stage solves, to their slots of the trig cache.
+    FillTrig,
+    /// An explicit stage's multipliers (force solve), to `lambda` at its equations.
+    Multipliers,
+    /// A block's force right-hand side (force solve), to `out`.
+    ForceRhs,
+}
+
+impl Method {
+    /// Every method, in kernel order.
+    pub const ALL: [Method; 9] = [
+        Method::Positions,
+        Method::Velocities,
+        Method::Accelerations,
+        Method::Jacobian,
+        Method::VelocityRhs,
+        Method::AccelerationRhs,
+        Method::FillTrig,
+        Method::Multipliers,
+        Method::ForceRhs,
+    ];
+
+    /// The method's facts (one row of the table in this module).
+    pub fn info(self) -> &'static MethodInfo {
+        &METHODS[self as usize]
+    }
+
+    /// When the kernel runs: see [`MethodInfo::phase`].
+    pub fn phase(self) -> Phase {
+        self.info().phase
+    }
+
+    /// The state its kernels may read besides the trig cache and time.
+    pub fn inputs(self) -> &'static [Input] {
+        self.info().inputs
+    }
+
+    /// The buffer its kernels write (a block's Jacobian also writes [`Buffer::Phi`]).
+    pub fn target(self) -> Buffer {
+        self.info().target
+    }
+
+    /// The kernel's name in stage `s` (`stage_3_positions`).
+    pub fn kernel_name(self, s: usize) -> String {
+        format!("stage_{s}_{}", self.info().suffix)
+    }
+}
+
+/// What a consumer needs to know about a [`Method`].
+#[derive(Debug)]
+pub struct MethodInfo {
+    /// The `Structured` method's name.
+    pub trait_method: &'static str,
+    /// Its kernels' names after `stage_s_`.
+    pub suffix: &'static str,
+    /// What its kernels do, for their documentation.
+    pub description: &'static str,
+    /// When it runs, which decides the trig slots it may read: a stage's positions (and the
+    /// sines it fills) only from earlier stages, its rates also from its own, the force solve
+    /// from every stage.
+    pub phase: Phase,
+    /// The state it reads besides the trig cache and time.
+    pub inputs: &'static [Input],
+    /// The buffer it writes.
+    pub target: Buffer,
+}
+
+const POSITIONS: &[Input] = &[Input::Q];
+const VELOCITIES: &[Input] = &[Input::Q, Input::Qd];
+const ACCELERATIONS: &[Input] = &[Input::Q, Input::Qd, Input::Qdd];
+const FORCES: &[Input] = &[Input::Q, Input::Qd, Input::Qdd, Input::Lambda];
+
+/// The methods' facts, in [`Method::ALL`] order.
+#[rustfmt::skip]
+const METHODS: [MethodInfo; 9] = [
+    //   trait method            kernel suffix       description                                          phase             reads          writes
+    info("assign_positions",     "positions",        "assigns the positions",                             Phase::Positions, POSITIONS,     Buffer::Q),
+    info("assign_velocities",    "velocities",       "assigns the velocities",                            Phase::After,     VELOCITIES,    Buffer::Qd),
+    info("assign_accelerations", "accelerations",    "assigns the accelerations",                         Phase::After,     ACCELERATIONS, Buffer::Qdd),
+    info("block_jacobian",       "jacobian",         "the block's residual and Jacobian values",          Phase::Positions, POSITIONS,     Buffer::Values),
+    info("velocity_rhs",         "velocity_rhs",     "the block's velocity right-hand side",              Phase::After,     VELOCITIES,    Buffer::Out),
+    info("acceleration_rhs",     "acceleration_rhs", "the block's acceleration right-hand side",          Phase::After,     ACCELERATIONS, Buffer::Out),
+    info("fill_trig",            "trig",             "caches the sines and cosines of its angles",        Phase::Positions, POSITIONS,     Buffer::Trig),
+    info("assign_multipliers",   "multipliers",      "assigns its equations' multipliers (force solve)",  Phase::Final,     FORCES,        Buffer::Lambda),
+    info("force_rhs",            "force_rhs",        "the block's force right-hand side",                 Phase::Final,     FORCES,        Buffer::Out),
+];
+
+const fn info(
+    trait_method: &'static str,
+    suffix: &'static str,
+    description: &'static str,
+    phase: Phase,
+    inputs: &'static [Input],
+    target: Buffer,
+) -> MethodInfo {
+    MethodInfo {
+        trait_method,
+        suffix,
+        description,
+        phase,
+        inputs,
+        target,
+    }
+}
+
+/// State a kernel reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Input {
+    /// Positions.
+    Q,
+    /// Velocities.
+    Qd,
+    /// Accelerations.
+    Qdd,
+    /// Multipliers.
+    Lambda,
+}
+
+impl Input {
+    /// The parameter's name in the `Structured` methods.
+    pub fn name(self) -> &'static str {
+        match self {
+            Input::Q => "q",
+            Input::Qd => "qd",
+            Input::Qdd => "qdd",
+            Input::Lambda => "lambda",
+        }
+    }
+}
+
+/// Where a kernel writes: the `Structured` method's output parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Buffer {
+    /// Positions, at coordinates.
+    Q,
+    /// Velocities, at coordinates.
+    Qd,
+    /// Accelerations, at coordinates.
+    Qdd,
+    /// Multipliers, at equations.
+    Lambda,
+    /// The trig cache, at slots.
+    Trig,
+    /// A block's residuals.
+    Phi,
+    /// A block's Jacobian values, in pattern order.
+    Values,
+    /// A right-hand side or a list of values, from 0.
+    Out,
+}
+
+impl Buffer {
+    /// The parameter's name in the `Structured` methods.
+    pub fn name(self) -> &'static str {
+        match self {
+            Buffer::Q => "q",
+            Buffer::Qd => "qd",
+            Buffer::Qdd => "qdd",
+            Buffer::Lambda => "lambda",
+            Buffer::Trig => "trig",
+            Buffer::Phi => "phi",
+            Buffer::Values => "values",
+            Buffer::Out => "out",
+        }
+    }
+}
+
+/// Expressions evaluated together, reading the trig cache where it is filled.
+#[derive(Debug, Clone)]
+pub struct Kernel {
+    /// The values, in output order.
+    pub roots: Vec<Id>,
+    /// Where each root's value goes (parallel to `roots`).
+    pub outputs: Vec<(Buffer, usize)>,
+    /// The cached sines and cosines the kernel reads, with their slots.
+    pub cached: HashMap<Id, usize>,
+}
+
+impl Kernel {
+    /// A kernel whose `i`-th value goes to `out[i]`.
+    fn listed(arena: &Arena, plan: &Plan, roots: &[Id], stage: usize, phase: Phase) -> Self {
+        let outputs = (0..roots.len()).map(|i| (Buffer::Out, i)).collect();
+        Kernel::new(arena, plan, roots.to_vec(), outputs, stage, phase)
+    }
+
+    fn new(
+        arena: &Arena,
+        plan: &Plan,
+        roots: Vec<Id>,
+        outputs: Vec<(Buffer, usize)>,
+        stage: usize,
+        phase: Phase,
+    ) -> Self {
+        let cached = plan.trig.reads(arena, &roots, stage, phase);
+        Kernel {
+            roots,
+            outputs,
+            cached,
+        }
+    }
+}
+
+/// A kernel of one stage, run by one method.
+#[derive(Debug, Clone)]
+pub struct StageKernel {
+    /// The stage.
+    pub stage: usize,
+    /// The method that runs it.
+    pub method: Method,
+    /// What it computes and where it writes.
+    pub kernel: Kernel,
+}
+
+/// What the runtime's `Stage` table says about a stage.
+#[derive(Debug, Clone)]
+pub struct StageShape {
+    /// The equations it solves.
+    pub equations: Vec<usize>,
+    /// The coordinates it solves for, in the same order.
+    pub coordinates: Vec<usize>,
+    /// The earlier stages it reads.
+    pub reads: Vec<usize>,
+    /// A Newton block's sparse system; `None` for an explicit stage.
+    pub block: Option<BlockShape>,
+}
+
+/// A Newton block's sparse system.
+#[derive(Debug, Clone)]
+pub struct BlockShape {
+    /// The Jacobian's structural non-zeros (row, column) in the block, in value order.
+    pub pattern: Vec<(usize, usize)>,
+    /// Value slots: the entries, then the static LU's fill-in.
+    pub slots: usize,
+    /// The value slot of each static pivot (empty without a static LU).
+    pub pivots: Vec<usize>,
+    /// Its static LU, an index into [`Kernels::factorizations`] (shared by blocks with the
+    /// same pattern); `None` when the block pivots at run time.
+    pub factorization: Option<usize>,
+}
+
+/// The storage the structured solve needs (the runtime's `Buffers` parameters).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sizes {
+    /// Equations of the largest block.
+    pub largest_block: usize,
+    /// Value slots of the block with the most.
+    pub largest_slots: usize,
+    /// Stages (at least 1: the runtime's arrays are never empty).
+    pub stages: usize,
+    /// Coordinates.
+    pub coordinates: usize,
+    /// Trig cache slots.
+    pub trig: usize,
+    /// For a scene that computes forces: the multipliers, then every block's archived factors.
+    pub forces: Option<usize>,
+}
+
+/// Every kernel of a scene's plan, and what the dispatch needs to run them.
+#[derive(Debug, Clone)]
+pub struct Kernels {
+    /// The per-stage kernels, by stage, then in [`Method`] order.
+    pub stages: Vec<StageKernel>,
+    /// The runtime's stage table.
+    pub shapes: Vec<StageShape>,
+    /// The distinct static LUs, in order of first use.
+    pub factorizations: Vec<Factorization>,
+    /// The markers at the solved state, reading the whole trig cache; `None` without markers.
+    pub markers: Option<Kernel>,
+    /// Each branch invariant at the solved positions, reading the trig cache.
+    pub branches: Vec<Kernel>,
+    /// The workspace.
+    pub sizes: Sizes,
+}
+
+impl Kernels {
+    /// The kernels of `method`, in stage order.
+    pub fn of(&self, method: Method) -> impl Iterator<Item = &StageKernel> {
+        self.stages.iter().filter(move |k| k.method == method)
+    }
+
+    /// The static LU of stage `s`, if it is a block that has one.
+    pub fn factorization(&self, s: usize) -> Option<&Factorization> {
+        let index = self.shapes.get(s)?.block.as_ref()?.factorization?;
+        self.factorizations.get(index)
+    }
+}
+
+/// The kernels of `plan` (and of the force solve, for a scene that computes forces); `markers`
+/// and `branches` are the scene's marker values and branch invariants.
+pub fn list(
+    arena: &Arena,
+    plan: &Plan,
+    forces: Option<&Forces>,
+    markers: &[Id],
+    branches: &[Id],
+) -> Kernels {
+    let mut factorizations = Factorizations::default();
+    let mut stages = Vec::new();
+    let mut shapes = Vec::new();
+    for s in 0..plan.stages.len() {
+        let force = forces.map(|f| &f.stages[s]);
+        stages.extend(
+            stage_kernels(arena, plan, s, force)
+                .into_iter()
+                .map(|(method, kernel)| StageKernel {
+                    stage: s,
+                    method,
+                    kernel,
+                }),
+        );
+        shapes.push(shape(plan, s, &mut factorizations));
+    }
+    let all_filled = plan.stages.len();
+    let markers = (!markers.is_empty())
+        .then(|| Kernel::listed(arena, plan, markers, all_filled, Phase::Final));
+    let branches = branches
+        .iter()
+        .map(|&b| Kernel::listed(arena, plan, &[b], all_filled, Phase::Positions))
+        .collect();
+    let dim = plan.stages.iter().map(stage_len).sum();
+    let sizes = Sizes {
+        largest_block: plan.largest_block(),
+        largest_slots: plan.largest_slots(),
+        stages: plan.stages.len().max(1),
+        coordinates: dim,
+        trig: plan.trig.len(),
+        forces: forces.map(|_| dim + plan.blocks().map(|b| b.slots()).sum::<usize>()),
+    };
+    Kernels {
+        stages,
+        shapes,
+        factorizations: factorizations.order.into_iter().cloned().collect(),
+        markers,
+        branches,
+        sizes,
+    }
+}
+
+/// Stage `s`'s kernels in [`Method`] order: its levels or its block's, the trig it fills, its
+/// force kernel.
+fn stage_kernels(
+    arena: &Arena,
+    plan: &Plan,
+    s: usize,
+    force: Option<&ForceStage>,
+) -> Vec<(Method, Kernel)> {
+    let kernel = |method: Method, roots: Vec<Id>, outputs: Vec<(Buffer, usize)>| {
+        (
+            method,
+            Kernel::new(arena, plan, roots, outputs, s, method.phase()),
+        )
+    };
+    let mut kernels = Vec::new();
+    match &plan.stages[s] {
+        Stage::Explicit(assignments) => {
+            let coordinates: Vec<usize> = assignments.iter().map(|a| a.coordinate).collect();
+            let levels = [
+                (
+                    Method::Positions,
+                    Some(assignments.iter().map(|a| a.position).collect()),
+                ),
+                (
+                    Method::Velocities,
+                    assignments.iter().map(|a| a.velocity).collect(),
+                ),
+                (
+                    Method::Accelerations,
+                    assignments.iter().map(|a| a.acceleration).collect(),
+                ),
+            ];
+            for (method, roots) in levels {
+                // A level the scene does not compute has no kernel.
+                let Some(roots) = roots else { continue };
+                let target = method.target();
+                let outputs = coordinates.iter().map(|&c| (target, c)).collect();
+                kernels.push(kernel(method, roots, outputs));
+            }
+        }
+        Stage::Block(block) => {
+            let roots = block
+                .residuals
+                .iter()
+                .copied()
+                .chain(block.entries.iter().map(|e| e.2))
+                .collect();
+            let outputs = (0..block.residuals.len())
+                .map(|r| (Buffer::Phi, r))
+                .chain((0..block.entries.len()).map(|k| (Buffer::Values, k)))
+                .collect();
+            kernels.push(kernel(Method::Jacobian, roots, outputs));
+            let rates = [
+                (Method::VelocityRhs, &block.velocity_rhs),
+                (Method::AccelerationRhs, &block.acceleration_rhs),
+            ];
+            for (method, roots) in rates {
+                let Some(roots) = roots else { continue };
+                let outputs = (0..roots.len()).map(|r| (Buffer::Out, r)).collect();
+                kernels.push(kernel(method, roots.clone(), outputs));
+            }
+        }
+    }
+    let fills: Vec<usize> = plan.trig.fills(s).collect();
+    if !fills.is_empty() {
+        let roots = fills
+            .iter()
+            .flat_map(|&m| {
+                let (sin, cos) = plan.trig.nodes[m];
+                [sin, cos]
+            })
+            .collect();
+        let outputs = fills
+            .iter()
+            .flat_map(|&m| [(Buffer::Trig, 2 * m), (Buffer::Trig, 2 * m + 1)])
+            .collect();
+        kernels.push(kernel(Method::FillTrig, roots, outputs));
+    }
+    match (&plan.stages[s], force) {
+        (_, None) => {}
+        (Stage::Explicit(assignments), Some(ForceStage::Explicit(values))) => {
+            let outputs = assignments
+                .iter()
+                .map(|a| (Buffer::Lambda, a.equation))
+                .collect();
+            kernels.push(kernel(Method::Multipliers, values.clone(), outputs));
+        }
+        (Stage::Block(_), Some(ForceStage::Block(values))) => {
+            let outputs = (0..values.len()).map(|j| (Buffer::Out, j)).collect();
+            kernels.push(kernel(Method::ForceRhs, values.clone(), outputs));
+        }
+        _ => unreachable!("the force plan follows the kinematic plan stage for stage"),
+    }
+    kernels
+}
+
+/// The distinct static LUs, numbered in order of first use.
+#[derive(Default)]
+struct Factorizations<'p> {
+    numbers: HashMap<&'p Factorization, usize>,
+    order: Vec<&'p Factorization>,
+}
+
+impl<'p> Factorizations<'p> {
+    fn index(&mut self, f: &'p Factorization) -> usize {
+        let next = self.order.len();
+        *self.numbers.entry(f).or_insert_with(|| {
+            self.order.push(f);
+            next
+        })
+    }
+}
+
+/// Stage `s`'s entry in the runtime's stage table; a block's static LU is numbered among
+/// `factorizations`, added there if it is the first of its pattern.
+fn shape<'p>(plan: &'p Plan, s: usize, factorizations: &mut Factorizations<'p>) -> StageShape {
+    let reads = plan.reads[s].clone();
+    match &plan.stages[s] {
+        Stage::Explicit(assignments) => StageShape {
+            equations: assignments.iter().map(|a| a.equation).collect(),
+            coordinates: assignments.iter().map(|a| a.coordinate).collect(),
+            reads,
+            block: None,
+        },
+        Stage::Block(block) => {
+            let factorization = block
+                .factorization
+                .as_ref()
+                .map(|f| factorizations.index(f));
+            StageShape {
+                equations: block.equations.clone(),
+                coordinates: block.coordinates.clone(),
+                reads,
+                block: Some(BlockShape {
+                    pattern: block.entries.iter().map(|&(r, c, _)| (r, c)).collect(),
+                    slots: block.slots(),
+                    pivots: block
+                        .factorization
+                        .as_ref()
+                        .map(Factorization::pivots)
+                        .unwrap_or_default(),
+                    factorization,
+                }),
+            }
+        }
+    }
+}
+
+/// The coordinates a stage solves for.
+fn stage_len(stage: &Stage) -> usize {
+    match stage {
+        Stage::Explicit(assignments) => assignments.len(),
+        Stage::Block(block) => block.coordinates.len(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Scene;
+
+    fn scene(source: &str) -> Scene {
+        crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    const FOUR_BAR: &str = include_str!("../../examples/scenes/four_bar.mech");
+    const DYNAMICS: &str = include_str!("../../examples/scenes/piston_crank_dynamics.mech");
+    const OFFSET_SLIDER: &str = include_str!("../../examples/scenes/offset_slider.mech");
+
+    /// Two four-bars side by side, each with its own crank: two blocks of one pattern.
+    const TWIN_FOUR_BARS: &str = "pub mechanism Twins {
+        ground frame at (0, 0, 0);
+        body c1 near (0, 0, 0);  body k1 near (40, 0, 0.6);  body r1 near (100, 0, 1.1);
+        body c2 near (0, 0, 0);  body k2 near (40, 0, 0.6);  body r2 near (100, 0, 1.1);
+        joint p1: revolute(frame, c1);
+        joint a1: revolute(c1 @ (40, 0), k1);
+        joint b1: revolute(k1 @ (120, 0), r1 @ (80, 0));
+        joint q1: revolute(r1, frame @ (100, 0));
+        joint p2: revolute(frame @ (0, 300), c2);
+        joint a2: revolute(c2 @ (40, 0), k2);
+        joint b2: revolute(k2 @ (120, 0), r2 @ (80, 0));
+        joint q2: revolute(r2, frame @ (100, 300));
+        driver d1: angle(c1) = t;
+        driver d2: angle(c2) = 2 * t;
+    }";
+
+    /// The facts table is indexed by the method: a row out of place would give a kernel
+    /// another method's phase, inputs or name.
+    #[test]
+    fn the_method_table_is_in_method_order() {
+        for (i, method) in Method::ALL.into_iter().enumerate() {
+            assert_eq!(method as usize, i);
+            let debug = format!("{method:?}").to_lowercase();
+            let info = method.info();
+            let named = info.trait_method.replace('_', "");
+            let found = named.contains(&debug) || debug.contains(info.suffix.trim_end_matches('s'));
+            assert!(found, "{method:?} has the row of {}", info.trait_method);
+        }
+    }
+
+    /// A kernel of stage `s` reads a cached sine only once it is filled: positions from
+    /// earlier stages, rates from earlier stages and its own, the force solve from any.
+    #[test]
+    fn kernels_read_only_the_trig_slots_their_phase_allows() {
+        for source in [FOUR_BAR, DYNAMICS, TWIN_FOUR_BARS] {
+            let scene = scene(source);
+            let trig = &scene.plan.trig;
+            let mut checked = 0;
+            for k in &scene.kernels.stages {
+                for &slot in k.kernel.cached.values() {
+                    let filled = trig.filled_by[slot / 2];
+                    let allowed = match k.method.phase() {
+                        Phase::Positions => filled < k.stage,
+                        Phase::After => filled <= k.stage,
+                        Phase::Final => true,
+                    };
+                    assert!(
+                        allowed,
+                        "{:?} of stage {} reads slot {slot}",
+                        k.method, k.stage
+                    );
+                    checked += 1;
+                }
+            }
+            assert!(checked > 0, "the scene reads the trig cache somewhere");
+        }
+    }
+
+    /// Each kernel writes one value per root to its method's buffer: an explicit stage's levels
+    /// to its coordinates, a block's Jacobian its residuals then its pattern's entries.
+    #[test]
+    fn each_kernel_writes_where_its_stage_says() {
+        let scene = scene(DYNAMICS);
+        let mut seen = std::collections::HashSet::new();
+        for k in &scene.kernels.stages {
+            assert!(
+                seen.insert((k.stage, k.method)),
+                "one kernel per stage and method"
+            );
+            assert_eq!(k.kernel.roots.len(), k.kernel.outputs.len());
+            let shape = &scene.kernels.shapes[k.stage];
+            match (&scene.plan.stages[k.stage], k.method) {
+                (
+                    Stage::Explicit(_),
+                    Method::Positions | Method::Velocities | Method::Accelerations,
+                ) => {
+                    let expected: Vec<_> = shape
+                        .coordinates
+                        .iter()
+                        .map(|&c| (k.method.target(), c))
+                        .collect();
+                    assert_eq!(k.kernel.outputs, expected);
+                }
+                (Stage::Explicit(_), Method::Multipliers) => {
+                    let expected: Vec<_> = shape
+                        .equations
+                        .iter()
+                        .map(|&e| (Buffer::Lambda, e))
+                        .collect();
+                    assert_eq!(k.kernel.outputs, expected);
+                }
+                (Stage::Block(block), Method::Jacobian) => {
+                    let roots: Vec<Id> = block
+                        .residuals
+                        .iter()
+                        .copied()
+                        .chain(block.entries.iter().map(|e| e.2))
+                        .collect();
+                    assert_eq!(k.kernel.roots, roots);
+                    let phi = k
+                        .kernel
+                        .outputs
+                        .iter()
+                        .filter(|o| o.0 == Buffer::Phi)
+                        .count();
+                    assert_eq!(phi, block.equations.len());
+                }
+                (
+                    Stage::Block(block),
+                    Method::VelocityRhs | Method::AccelerationRhs | Method::ForceRhs,
+                ) => {
+                    assert_eq!(k.kernel.roots.len(), block.equations.len());
+                }
+                (_, Method::FillTrig) => {
+                    let slots: Vec<usize> = scene
+                        .plan
+                        .trig
+                        .fills(k.stage)
+                        .flat_map(|m| [2 * m, 2 * m + 1])
+                        .collect();
+                    let written: Vec<usize> = k.kernel.outputs.iter().map(|o| o.1).collect();
+                    assert_eq!(written, slots);
+                }
+                (stage, method) => panic!("{method:?} in {stage:?}"),
+            }
+        }
+        let methods: Vec<Method> = scene.kernels.stages.iter().map(|k| k.method).collect();
+        for method in [Method::Multipliers, Method::ForceRhs, Method::Jacobian] {
+            assert!(methods.contains(&method), "{method:?}");
+        }
+    }
+
+    /// The levels a scene did not ask for have no kernels, nor does the force solve of a
+    /// scene without forces.
+    #[test]
+    fn kernels_follow_the_outputs_asked_for() {
+        let positions = scene(OFFSET_SLIDER);
+        assert!(positions.kernels.stages.iter().all(|k| matches!(
+            k.method,
+            Method::Positions | Method::Jacobian | Method::FillTrig
+        )));
+        assert_eq!(positions.kernels.sizes.forces, None);
+        let forces = scene(DYNAMICS);
+        let dim = forces.model.dim();
+        let archive: usize = forces.plan.blocks().map(|b| b.slots()).sum();
+        assert_eq!(forces.kernels.sizes.forces, Some(dim + archive));
+        assert_eq!(forces.kernels.sizes.coordinates, dim);
+    }
+
+    /// Blocks of one pattern share one static LU; the shape of each block points at it.
+    #[test]
+    fn blocks_of_one_pattern_share_their_static_lu() {
+        let scene = scene(TWIN_FOUR_BARS);
+        let blocks: Vec<&BlockShape> = scene
+            .kernels
+            .shapes
+            .iter()
+            .filter_map(|s| s.block.as_ref())
+            .collect();
+        assert_eq!(blocks.len(), 2, "one block per loop");
+        assert_eq!(scene.kernels.factorizations.len(), 1);
+        for (s, shape) in scene.kernels.shapes.iter().enumerate() {
+            if let Some(block) = &shape.block {
+                assert_eq!(block.factorization, Some(0));
+                assert_eq!(
+                    scene.kernels.factorization(s),
+                    Some(&scene.kernels.factorizations[0])
+                );
+                assert_eq!(block.pivots, scene.kernels.factorizations[0].pivots());
+            } else {
+                assert_eq!(scene.kernels.factorization(s), None);
+            }
+        }
+    }
+}
