@@ -1,8 +1,9 @@
-//! Tools over the interpreter: the `mechgen` command line (`expand`, `check`, `solve`) and the
-//! [`Interpreted`] adapter that runs `.mech` scenes through the runtime's solver.
+//! The `mechgen` command line (`expand`, `check`, `solve`, `completions`): a front end over
+//! `mechgen` and the interpreter (`mechgen_interp::Interpreted`), which runs `.mech` scenes
+//! through the runtime's solver. Here: arguments, reading scenes, the commands and their output.
 //!
-//! The binary is a thin wrapper around [`run`]; the pieces are public so that tests and reports
-//! can reuse them. Equally spaced sample times come from [`mechgen_runtime::sample_time`], as
+//! The binary is a thin wrapper around [`run`]; the pieces are public so that tests can reuse
+//! them. Equally spaced sample times come from [`mechgen_runtime::sample_time`], as
 //! in the examples; listed ones (`--at`, `--times`) are solved at exactly the doubles given.
 
 pub mod args;
@@ -15,10 +16,10 @@ use std::io::{self, Read, Write};
 use std::path::Path;
 
 pub use args::Command;
-pub use mechgen_interp::Interpreted;
 
 use args::{Input, Output, SolveArgs, Times};
 use mechgen::limits::Limits;
+use mechgen_interp::Interpreted;
 use mechgen_runtime::sample_time;
 
 /// Exit status for a bad command line.
@@ -226,15 +227,8 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
     let (out, destination): (&mut dyn Write, String) = match &args.out {
         Output::Stdout => (stdout, "stdout".to_owned()),
         Output::File(path) => {
-            refuse_to_overwrite_input(&args.input, path)?;
-            let name = path.display().to_string();
-            file = io::BufWriter::new(std::fs::File::create(path).map_err(|e| {
-                failed(format_args!(
-                    "cannot create `{name}`: {e}\n  hint: check that its directory exists \
-                     and is writable"
-                ))
-            })?);
-            (&mut file, format!("`{name}`"))
+            file = create_output(&args.input, path)?;
+            (&mut file, format!("`{}`", path.display()))
         }
     };
 
@@ -254,7 +248,17 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
         args.diagnostics,
         out,
     );
-    let range = schedule.describe();
+    finish(outcome, &schedule.describe(), &destination, stderr)
+}
+
+/// The summary line on stderr after a complete run, or the failure with what was written
+/// before it.
+fn finish(
+    outcome: Result<solve::Summary, solve::RunError>,
+    range: &str,
+    destination: &str,
+    stderr: &mut dyn Write,
+) -> Result<(), Failure> {
     match outcome {
         Ok(summary) => {
             let _ = writeln!(
@@ -267,13 +271,26 @@ fn solve(args: &SolveArgs, stdout: &mut dyn Write, stderr: &mut dyn Write) -> Re
             );
             Ok(())
         }
-        Err(solve::RunError::Write(e)) => Err(write_failure(&e, &destination)),
+        Err(solve::RunError::Write(e)) => Err(write_failure(&e, destination)),
         Err(solve::RunError::Solve { message, summary }) => Err(failed(format_args!(
             "{message}\n  note: wrote {} to {destination} ({}) before the failure",
             count(summary.rows, "row"),
             count(summary.iterations, "Newton iteration"),
         ))),
     }
+}
+
+/// The `--out` file, created (truncated) unless it is the scene itself.
+fn create_output(input: &Input, path: &Path) -> Result<io::BufWriter<std::fs::File>, Failure> {
+    refuse_to_overwrite_input(input, path)?;
+    let name = path.display().to_string();
+    let file = std::fs::File::create(path).map_err(|e| {
+        failed(format_args!(
+            "cannot create `{name}`: {e}\n  hint: check that its directory exists \
+             and is writable"
+        ))
+    })?;
+    Ok(io::BufWriter::new(file))
 }
 
 /// The sample times of a run, with a `--times` file read.
