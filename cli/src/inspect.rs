@@ -7,7 +7,8 @@
 use core::fmt::{self, Write};
 
 use mechgen::Scene;
-use mechgen::model::ConstraintKind;
+use mechgen::interpret::Env;
+use mechgen::model::{ConstraintKind, Model};
 use serde::Serialize;
 
 /// What `check` reports about a scene, rendered as text ([`report`]) or JSON ([`json`]; the
@@ -85,27 +86,11 @@ pub struct Branch {
 pub fn summary(scene: &Scene, file: &str) -> Summary {
     let model = &scene.model;
     let moving = model.bodies.iter().filter(|b| !b.ground).count();
-    let joint_equations: usize = model
-        .constraints
-        .iter()
-        .filter(|c| {
-            !matches!(
-                c.kind,
-                ConstraintKind::Ground { .. } | ConstraintKind::Driver { .. }
-            )
-        })
-        .map(|c| c.kind.equation_suffixes().len())
-        .sum();
-    let env = mechgen::interpret::Env {
+    let joint_equations = joint_equations(model);
+    let env = Env {
         params: model.params.iter().map(|p| p.default).collect(),
         ..Default::default()
     };
-    let scale = &scene.kinematics.length_scale;
-    let dependent: Vec<f64> = scale
-        .dependent
-        .iter()
-        .map(|&id| mechgen::interpret::eval(&model.arena, id, &env))
-        .collect();
     Summary {
         mechanism: model.name.to_string(),
         file: file.to_owned(),
@@ -119,7 +104,7 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
         joint_equations,
         drivers: model.driver_count(),
         jacobian_nonzeros: scene.kinematics.jacobian.len(),
-        length_scale: scale.evaluate(&dependent),
+        length_scale: length_scale(scene, &env),
         parameters: model
             .params
             .iter()
@@ -144,20 +129,52 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
                 invariant: model.describe_branch(b),
             })
             .collect(),
-        forces: scene.forces.as_ref().map(|_| ForceSummary {
-            bodies_with_mass: model
-                .bodies
-                .iter()
-                .filter(|b| b.mass.is_some())
-                .map(|b| b.name.to_string())
-                .collect(),
-            // `+ 0.0`: no `-0` in the report (a gravity `(0, -9810)` folds its x to −0).
-            gravity: model
-                .gravity
-                .map(|g| mechgen::interpret::eval(&model.arena, g, &env) + 0.0),
-            loads: model.loads.iter().map(|l| l.name.clone()).collect(),
-            reactions: model.reaction_names(),
-        }),
+        forces: scene.forces.as_ref().map(|_| force_summary(model, &env)),
+    }
+}
+
+/// Equations of the joints (drivers and the ground's fixing excluded): the Gruebler count's.
+fn joint_equations(model: &Model) -> usize {
+    model
+        .constraints
+        .iter()
+        .filter(|c| {
+            !matches!(
+                c.kind,
+                ConstraintKind::Ground { .. } | ConstraintKind::Driver { .. }
+            )
+        })
+        .map(|c| c.kind.equation_suffixes().len())
+        .sum()
+}
+
+/// The scene's length scale with the parameters' defaults in `env`.
+fn length_scale(scene: &Scene, env: &Env) -> f64 {
+    let scale = &scene.kinematics.length_scale;
+    let dependent: Vec<f64> = scale
+        .dependent
+        .iter()
+        .map(|&id| mechgen::interpret::eval(&scene.model.arena, id, env))
+        .collect();
+    scale.evaluate(&dependent)
+}
+
+/// What produces the forces of a scene that computes them, with the parameters' defaults in
+/// `env`.
+fn force_summary(model: &Model, env: &Env) -> ForceSummary {
+    ForceSummary {
+        bodies_with_mass: model
+            .bodies
+            .iter()
+            .filter(|b| b.mass.is_some())
+            .map(|b| b.name.to_string())
+            .collect(),
+        // `+ 0.0`: no `-0` in the report (a gravity `(0, -9810)` folds its x to −0).
+        gravity: model
+            .gravity
+            .map(|g| mechgen::interpret::eval(&model.arena, g, env) + 0.0),
+        loads: model.loads.iter().map(|l| l.name.clone()).collect(),
+        reactions: model.reaction_names(),
     }
 }
 
@@ -176,20 +193,40 @@ pub fn report(scene: &Scene, file: &str, stats: bool) -> String {
 }
 
 fn write_report(out: &mut String, scene: &Scene, s: &Summary, stats: bool) -> fmt::Result {
-    let (moving, ground) = (s.moving_bodies, s.ground_bodies);
     writeln!(
         out,
-        "mechanism {} ({}): {} bodies ({moving} moving, {ground} ground), {} constraints",
+        "mechanism {} ({}): {} bodies ({} moving, {} ground), {} constraints",
         s.mechanism,
         s.file,
-        moving + ground,
+        s.moving_bodies + s.ground_bodies,
+        s.moving_bodies,
+        s.ground_bodies,
         s.constraints
     )?;
     writeln!(out, "\ncoordinates ({}):", s.coordinates.len())?;
     numbered(out, &s.coordinates)?;
     writeln!(out, "\nequations ({}):", s.equations.len())?;
     numbered(out, &s.equations)?;
+    write_mobility(out, scene, s)?;
+    write_parameters(out, s)?;
+    if !s.branches.is_empty() {
+        writeln!(out, "\nbranch invariants ({}):", s.branches.len())?;
+        for b in &s.branches {
+            writeln!(out, "  {}: {}", b.name, b.invariant)?;
+        }
+    }
+    if let Some(f) = &s.forces {
+        write_forces(out, f)?;
+    }
+    if stats {
+        write_stats(out, scene)?;
+    }
+    Ok(())
+}
 
+/// Degrees of freedom against drivers, the Jacobian's sparsity and the length scale.
+fn write_mobility(out: &mut String, scene: &Scene, s: &Summary) -> fmt::Result {
+    let moving = s.moving_bodies;
     let (dof, joint_equations, drivers) = (s.degrees_of_freedom, s.joint_equations, s.drivers);
     let verdict = if dof == drivers as i64 {
         "matched by"
@@ -226,73 +263,62 @@ fn write_report(out: &mut String, scene: &Scene, s: &Summary, stats: bool) -> fm
         } else {
             ", with the parameters' defaults"
         }
-    )?;
+    )
+}
 
+/// The parameters with their defaults, then the derived ones with their values.
+fn write_parameters(out: &mut String, s: &Summary) -> fmt::Result {
     if s.parameters.is_empty() {
         writeln!(out, "\nparameters: none")?;
     } else {
         writeln!(out, "\nparameters ({}):", s.parameters.len())?;
-        let width = s.parameters.iter().map(|p| p.name.len()).max();
-        for p in &s.parameters {
-            writeln!(
-                out,
-                "  {:<w$} = {}",
-                p.name,
-                p.default,
-                w = width.unwrap_or(0)
-            )?;
-        }
+        aligned(out, &s.parameters)?;
     }
-
     if !s.derived_parameters.is_empty() {
         writeln!(
             out,
             "derived parameters ({}), computed from those above:",
             s.derived_parameters.len()
         )?;
-        let width = s.derived_parameters.iter().map(|p| p.name.len()).max();
-        for p in &s.derived_parameters {
-            writeln!(
-                out,
-                "  {:<w$} = {}",
-                p.name,
-                p.default,
-                w = width.unwrap_or(0)
-            )?;
-        }
-    }
-
-    if !s.branches.is_empty() {
-        writeln!(out, "\nbranch invariants ({}):", s.branches.len())?;
-        for b in &s.branches {
-            writeln!(out, "  {}: {}", b.name, b.invariant)?;
-        }
-    }
-
-    if let Some(f) = &s.forces {
-        let list = |names: &[String]| {
-            if names.is_empty() {
-                "none".to_owned()
-            } else {
-                names.join(", ")
-            }
-        };
-        writeln!(
-            out,
-            "\nforces: masses on {}; gravity ({}, {}); loads: {}",
-            list(&f.bodies_with_mass),
-            f.gravity[0],
-            f.gravity[1],
-            list(&f.loads)
-        )?;
-        writeln!(out, "reactions ({}):", f.reactions.len())?;
-        numbered(out, &f.reactions)?;
-    }
-
-    if stats {
-        write_stats(out, scene)?;
+        aligned(out, &s.derived_parameters)?;
     }
     Ok(())
+}
+
+/// `  name = value`, one per line, the `=` aligned.
+fn aligned(out: &mut String, parameters: &[Parameter]) -> fmt::Result {
+    let width = parameters.iter().map(|p| p.name.len()).max();
+    for p in parameters {
+        writeln!(
+            out,
+            "  {:<w$} = {}",
+            p.name,
+            p.default,
+            w = width.unwrap_or(0)
+        )?;
+    }
+    Ok(())
+}
+
+/// What produces the forces, and the reactions reported.
+fn write_forces(out: &mut String, f: &ForceSummary) -> fmt::Result {
+    let list = |names: &[String]| {
+        if names.is_empty() {
+            "none".to_owned()
+        } else {
+            names.join(", ")
+        }
+    };
+    writeln!(
+        out,
+        "\nforces: masses on {}; gravity ({}, {}); loads: {}",
+        list(&f.bodies_with_mass),
+        f.gravity[0],
+        f.gravity[1],
+        list(&f.loads)
+    )?;
+    writeln!(out, "reactions ({}):", f.reactions.len())?;
+    numbered(out, &f.reactions)
 }
 
 fn numbered(out: &mut String, names: &[String]) -> fmt::Result {

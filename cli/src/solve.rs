@@ -3,12 +3,11 @@
 
 use std::io::Write;
 
+use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::DVector;
 use mechgen_runtime::{
     GUESS_TIME, Mechanism, Quantity, Simulation, SolveError, Solver, State, write_csv_header,
 };
-
-use crate::Interpreted;
 
 /// Totals over a run, for the summary line.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

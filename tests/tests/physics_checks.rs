@@ -1,8 +1,8 @@
 //! Masses, inertias, spring constants and gear ratios written in parameters obey, at run time,
 //! the rules constants obey at compile time: `--set m=-1` is refused with a typed error naming
 //! the parameter, the body or load and the rule, instead of solving for a body of −1 kg. In
-//! generated code, the interpreter, the dense reference and the CLI; a scene whose physics is
-//! constant generates no check.
+//! generated code, the interpreter and the dense reference (the CLI's refusal is tested in
+//! `cli/tests/physics_checks.rs`); a scene whose physics is constant generates no check.
 
 use mechgen_interp::Interpreted;
 use mechgen_runtime::{
@@ -156,34 +156,6 @@ fn generated_code_checks_physics_set_at_run_time() {
 fn the_interpreter_checks_physics_set_at_run_time() {
     let scene = mechgen::compile_str(LOADED).unwrap();
     refuses_bad_physics(|p, v| solve_with(Interpreted::new(&scene), p, v));
-}
-
-#[test]
-fn the_cli_refuses_bad_physics_from_set() {
-    let dir = std::env::temp_dir().join(format!("mechgen-physics-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("loaded.mech");
-    std::fs::write(&path, LOADED).unwrap();
-    for (parameter, value, _, _, named) in BAD {
-        let set = format!("{parameter}={value}");
-        let args = [
-            "solve",
-            path.to_str().unwrap(),
-            "--at",
-            "0,0.1",
-            "--set",
-            &set,
-        ];
-        let (mut out, mut err) = (Vec::new(), Vec::new());
-        let code = mechgen_cli::run(args.iter().map(|a| a.into()), &mut out, &mut err);
-        let err = String::from_utf8_lossy(&err);
-        assert_eq!(code, 1, "{set}: {err}");
-        assert!(
-            err.contains(named) && err.contains(&format!("`{parameter}`")),
-            "{err}"
-        );
-    }
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! Reads the figures of the last `cargo bench -p mechgen-examples --bench kinematics` run, so
+//! Reads the figures of the last `cargo bench -p mechgen-benches --bench kinematics` run, so
 //! the report can print them beside its own: the benchmarks time the same calls (Φ+Φ_q, one
 //! step at the reference setting) for the same methods.
 //!

@@ -433,7 +433,7 @@ fn markdown(report: &Report, criterion_dir: &Path) -> String {
         reference_table(&mut s, scene);
         s.push_str(
             "\nPer call, at a solved state a tenth of a revolution in. The criterion columns \
-             come from the last `cargo bench -p mechgen-examples --bench kinematics` (— when it \
+             come from the last `cargo bench -p mechgen-benches --bench kinematics` (— when it \
              has not been run), which times the same calls, and steps at the reference setting: \
              its fastest sample is the figure comparable to this report's (both keep the \
              fastest stretches); its median runs higher on a machine whose speed varies.\n\n",

@@ -13,8 +13,8 @@
 //! Methods per scene: `closed_form`; `generated` (the emitted structured solve); `dense` (the
 //! same generated equations through the dense one-block reference); the accuracy report's
 //! Jacobian baselines around the same scene (finite differences, forward-mode AD, all dense);
-//! `naive` (the seed emitted without folding, simplification or sharing); `interpreted` (the
-//! CLI's interpreter on the scene's `.mech` twin). Besides `step`, each solver method times Φ,
+//! `naive` (the seed emitted without folding, simplification or sharing); `interpreted`
+//! (`mechgen-interp` on the scene's `.mech` twin). Besides `step`, each solver method times Φ,
 //! Φ_q and Φ+Φ_q at an assembled state, which the report prints beside its own figures.
 //!
 //! The group `seed/safeguards` times a seed step with the stability safeguards (unit scaling,
@@ -27,7 +27,7 @@
 //! `closed_form`, `generated` and `dense`, and their ratios: fastest batches, because the
 //! machines are shared and noise only ever adds time.
 //!
-//! `cargo bench -p mechgen-examples --bench kinematics`
+//! `cargo bench -p mechgen-benches --bench kinematics`
 
 use std::cell::RefCell;
 use std::hint::black_box;
@@ -45,8 +45,7 @@ use mechgen_runtime::{
 };
 
 /// The seed generated naively (no folding, no simplification, no shared sub-expressions) by
-/// the package's `build.rs`: the baseline the lean code is timed against. Bench-only, so the
-/// examples do not pay for compiling it.
+/// the package's `build.rs`: the baseline the lean code is timed against.
 // Deliberately unsimplified code (`0.0 - 0.0`, `x * 1.0`, …): lints about it are the point.
 #[allow(missing_docs, dead_code, clippy::all)]
 mod naive {
@@ -105,7 +104,7 @@ fn time_steps<S: Clone>(
 
 /// The IR of a scene's `.mech` twin.
 fn scene(file: &str) -> mechgen::Scene {
-    let path = format!("{}/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
+    let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
     let source = std::fs::read_to_string(&path).expect("scene file");
     mechgen::compile_str(&source).unwrap_or_else(|e| panic!("{path}: {e}"))
 }

@@ -1,11 +1,12 @@
 //! Generates the naive baseline of the seed (no folding, no simplification, no shared
 //! sub-expressions) into `OUT_DIR`, so benchmarks can time the lean generated code against it
-//! in the same run (included by `benches/kinematics.rs` only).
+//! in the same run (included by `benches/kinematics.rs`).
 
 use std::path::PathBuf;
 
 fn main() {
-    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/piston_crank.mech");
+    let scene =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/scenes/piston_crank.mech");
     println!("cargo:rerun-if-changed={}", scene.display());
     let source = std::fs::read_to_string(&scene).expect("the seed scene is readable");
     let options = mechgen::CodegenOptions {
