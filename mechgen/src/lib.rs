@@ -31,6 +31,7 @@ pub mod kinematics;
 pub mod limits;
 pub mod markers;
 pub mod model;
+pub mod motion;
 pub mod parse;
 pub mod physics;
 pub mod reactions;
