@@ -263,6 +263,18 @@ fn seed(c: &mut Criterion, fastest: &Fastest) {
         period / STEPS as f64,
         |f, t| f.kinematics(t),
     );
+    closed(
+        c,
+        fastest,
+        "seed/written_out",
+        form,
+        period / STEPS as f64,
+        |f, t| {
+            let mut step = ([0.0; 15], [0.0; 15], [0.0; 15]);
+            f.written_out(t, &mut step);
+            step
+        },
+    );
     driven(c, fastest, "seed/generated", seed, period);
     driven(c, fastest, "seed/dense", Dense::new(seed), period);
     driven(
@@ -338,6 +350,18 @@ fn four_bar(c: &mut Criterion, fastest: &Fastest) {
         period / STEPS as f64,
         |f, t| f.kinematics(t),
     );
+    closed(
+        c,
+        fastest,
+        "four_bar/written_out",
+        form,
+        period / STEPS as f64,
+        |f, t| {
+            let mut step = ([0.0; 12], [0.0; 12], [0.0; 12]);
+            f.written_out(t, &mut step);
+            step
+        },
+    );
     driven(c, fastest, "four_bar/generated", four_bar, period);
     driven(c, fastest, "four_bar/dense", Dense::new(four_bar), period);
     let forward = Dense::new(ForwardDifference::new(four_bar));
@@ -384,7 +408,8 @@ fn offset_slider(c: &mut Criterion, fastest: &Fastest) {
     );
 }
 
-/// The ratio table: fastest batch per step against the scene's closed form.
+/// The ratio table: fastest batch per step against the scene's closed form, and the
+/// generated step against the closed form written out by hand where there is one.
 fn summary(fastest: &Fastest) {
     println!("\nfastest batch per step (ns), and × the closed form:");
     println!(
@@ -411,6 +436,16 @@ fn summary(fastest: &Fastest) {
             cell(time("generated")),
             cell(time("dense"))
         );
+    }
+    for scene in ["seed", "four_bar"] {
+        let time = |method: &str| fastest.get(&format!("{scene}/{method}"));
+        if let (Some(hand), Some(generated)) = (time("written_out"), time("generated")) {
+            println!(
+                "  {scene}: written out by hand {:.1} ns per step; generated {:.2}× that",
+                hand * 1e9,
+                generated / hand
+            );
+        }
     }
     if let (Some(forces), Some(kinematics)) = (
         fastest.get("seed_forces/generated"),
