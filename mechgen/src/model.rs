@@ -610,3 +610,172 @@ impl Model {
             .count()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{Outputs, Unit};
+    use crate::expr::Node;
+
+    /// Ground, revolute, prismatic, distance, weld and a driver, two markers and a branch.
+    /// Constraints in equation order: the ground frame, the joints as declared, the driver.
+    fn scene(outputs: &str) -> crate::Scene {
+        let source = format!(
+            "mechanism Kinds {{
+                param r = 40;
+                ground frame at (0, 0, 0);
+                body crank near (0, 0, 0);
+                body slider near (140, 0, 0);
+                body arm near (140, 5, 0);
+                joint pivot: revolute(frame, crank);
+                joint guide: prismatic(frame, slider, along (1, 0));
+                joint link: distance(crank @ (r, 0), slider, 100);
+                joint glue: weld(slider @ (0, 5), arm);
+                driver spin: angle(crank) = t;
+                marker tip: arm @ (3, 4);
+                marker swing: angle(crank, arm);
+                branch ahead: cross(frame -> crank @ (r, 0), slider -> slider @ (0, 5)) > 0;
+                {outputs}
+            }}"
+        );
+        crate::compile_str(&source).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    #[test]
+    fn coordinates_are_named_and_measured_body_by_body() {
+        let model = scene("").model;
+        assert_eq!(model.dim(), 12);
+        let names = model.coordinate_names();
+        assert_eq!(names[..3], ["frame.x", "frame.y", "frame.theta"]);
+        assert_eq!(names[9..], ["arm.x", "arm.y", "arm.theta"]);
+        let (l, a) = (Unit::Length, Unit::Angle);
+        assert_eq!(model.coordinate_units(), [l, l, a].repeat(4));
+    }
+
+    #[test]
+    fn equations_are_named_and_measured_in_phi_order() {
+        let model = scene("").model;
+        assert_eq!(
+            model.equation_names(),
+            [
+                "frame.x",
+                "frame.y",
+                "frame.theta",
+                "pivot.x",
+                "pivot.y",
+                "guide.normal",
+                "guide.angle",
+                "link",
+                "glue.x",
+                "glue.y",
+                "glue.angle",
+                "spin",
+            ]
+        );
+        let (l, a, area) = (Unit::Length, Unit::Angle, Unit::Area);
+        assert_eq!(
+            model.equation_units(),
+            [l, l, a, l, l, l, a, area, l, l, a, a]
+        );
+        // One reaction per equation, named by what it reports.
+        assert_eq!(
+            model.reaction_names(),
+            [
+                "frame.fx",
+                "frame.fy",
+                "frame.torque",
+                "pivot.fx",
+                "pivot.fy",
+                "guide.normal",
+                "guide.torque",
+                "link.tension",
+                "glue.fx",
+                "glue.fy",
+                "glue.torque",
+                "spin.effort",
+            ]
+        );
+        assert_eq!(model.driver_count(), 1);
+        // Each constraint's suffixes, units and reactions agree in number.
+        for c in &model.constraints {
+            let k = c.kind.equation_suffixes().len();
+            assert_eq!(c.kind.equation_units().len(), k, "{}", c.name);
+            assert_eq!(c.kind.reaction_suffixes().len(), k, "{}", c.name);
+        }
+    }
+
+    #[test]
+    fn marker_values_follow_the_outputs_marker_by_marker() {
+        let positions = scene("outputs positions;").model;
+        assert_eq!(positions.marker_names(), ["tip.x", "tip.y", "swing.angle"]);
+        let velocities = scene("outputs positions, velocities;").model;
+        assert_eq!(
+            velocities.marker_names(),
+            [
+                "tip.x",
+                "tip.y",
+                "tip.x_dot",
+                "tip.y_dot",
+                "swing.angle",
+                "swing.angle_dot"
+            ]
+        );
+        let all = scene("").model;
+        assert_eq!(all.outputs, Outputs::Accelerations);
+        assert_eq!(all.marker_names().len(), 9);
+        assert_eq!(all.marker_names()[4..6], ["tip.x_ddot", "tip.y_ddot"]);
+        // Forces add no marker values.
+        let tip = all.markers[0].kind;
+        assert_eq!(
+            tip.suffixes(Outputs::Forces),
+            tip.suffixes(Outputs::Accelerations)
+        );
+    }
+
+    #[test]
+    fn outputs_are_ordered_levels_named_as_in_specs_and_the_runtime() {
+        assert!(Outputs::ALL.windows(2).all(|w| w[0] < w[1]));
+        for (level, name) in Outputs::ALL.into_iter().zip(Outputs::NAMES) {
+            assert_eq!(level.name().to_lowercase(), name);
+        }
+        let units = [Unit::Angle, Unit::Length, Unit::Area].map(Unit::name);
+        assert_eq!(units, ["Angle", "Length", "Area"]);
+    }
+
+    #[test]
+    fn lengths_are_listed_once_in_declaration_order() {
+        let model = scene("").model;
+        let lengths: Vec<Node> = model
+            .lengths()
+            .into_iter()
+            .map(|id| model.arena.node(id))
+            .collect();
+        // The frame's x and y (0, once), the link's point (r, 0: r new) and length, the weld's
+        // point (0, 5); not the bodies' guesses, the guide's axis or the driver's value.
+        let constant = |v: f64| Node::Const(f64::to_bits(v));
+        assert_eq!(
+            lengths,
+            [
+                constant(0.0),
+                Node::Param(0),
+                constant(100.0),
+                constant(5.0)
+            ]
+        );
+    }
+
+    #[test]
+    fn points_and_branches_are_described_as_written() {
+        let model = scene("").model;
+        let branch = &model.branches[0];
+        // The crank's point is in a parameter: its coordinates are not written out.
+        assert_eq!(
+            model.describe_branch(branch),
+            "cross(frame -> crank @ (…), slider -> slider @ (0, 5)) > 0"
+        );
+        let tip = match model.markers[0].kind {
+            super::MarkerKind::Point(p) => p,
+            super::MarkerKind::Angle(..) => panic!("`tip` is a point"),
+        };
+        assert_eq!(model.describe_point(tip), "arm @ (3, 4)");
+    }
+}

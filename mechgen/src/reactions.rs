@@ -405,8 +405,176 @@ fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
 #[cfg(test)]
 mod tests {
     use super::{ForceStage, assert_reads_later_stages, resolution_order};
-    use crate::expr::{Var, var_index};
+    use crate::expr::{Arena, Id, Var, var_index};
+    use crate::interpret::{Inputs, Tape};
     use crate::structure::Stage;
+
+    fn compile(source: &str) -> crate::Scene {
+        crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// `id` at positions `q` and multipliers `lambda` (at rest, t = 0, default parameters).
+    fn value(arena: &Arena, id: Id, q: &[f64], lambda: &[f64]) -> f64 {
+        let tape = Tape::new(arena, &[id]);
+        let rest = vec![0.0; q.len()];
+        let inputs = Inputs {
+            q,
+            qd: &rest,
+            qdd: &rest,
+            trig: &[],
+            lambda,
+            t: 0.0,
+            params: &[],
+        };
+        let mut out = [0.0];
+        tape.eval(inputs, &mut tape.scratch(), &mut out);
+        out[0]
+    }
+
+    /// The multipliers at `q` by the reverse sweep: stages from last to first, an explicit
+    /// stage's values evaluated, a 1 × 1 block's right-hand side divided by its entry. A
+    /// multiplier not computed yet is NaN, so reading one shows.
+    fn multipliers(scene: &crate::Scene, q: &[f64]) -> Vec<f64> {
+        let forces = scene.forces.as_ref().expect("the scene computes forces");
+        let arena = &scene.model.arena;
+        assert_eq!(forces.stages.len(), scene.plan.stages.len());
+        let mut lambda = vec![f64::NAN; q.len()];
+        for (stage, force) in scene.plan.stages.iter().zip(&forces.stages).rev() {
+            match (stage, force) {
+                (Stage::Explicit(assignments), ForceStage::Explicit(values)) => {
+                    assert_eq!(assignments.len(), values.len());
+                    let values: Vec<f64> = values
+                        .iter()
+                        .map(|&v| value(arena, v, q, &lambda))
+                        .collect();
+                    for (a, v) in assignments.iter().zip(values) {
+                        lambda[a.equation] = v;
+                    }
+                }
+                (Stage::Block(block), ForceStage::Block(rhs)) => {
+                    assert_eq!(block.entries.len(), 1, "these scenes' blocks are 1 × 1");
+                    let pivot = value(arena, block.entries[0].2, q, &lambda);
+                    lambda[block.equations[0]] = value(arena, rhs[0], q, &lambda) / pivot;
+                }
+                _ => panic!("a force stage of another kind than its plan stage"),
+            }
+        }
+        lambda
+    }
+
+    /// A static crank and slider joined by a distance link, the slider pushed back. Coordinates:
+    /// frame 0–2, crank 3–5, slider 6–8. Equations: frame 0–2, pivot 3–4, link 5, guide 6–7
+    /// (normal, angle), spin 8.
+    const CRANK_AND_LINK: &str = "mechanism CrankAndLink {
+        ground frame at (0, 0, 0);
+        body crank near (0, 0, 0);
+        body slider near (140, 0, 0);
+        joint pivot: revolute(frame, crank);
+        joint link: distance(crank @ (40, 0), slider, 100);
+        joint guide: prismatic(frame, slider, along (1, 0));
+        driver spin: angle(crank) = t;
+        load push: force(slider) = (-100, 0);
+    }";
+
+    #[test]
+    fn the_reverse_sweep_gives_the_effort_of_virtual_work() {
+        let scene = compile(CRANK_AND_LINK);
+        // Fixed, the crank's angle, the slider's x alone (the link is not affine in it).
+        let kinds: Vec<bool> = (scene.plan.stages.iter())
+            .map(|s| matches!(s, Stage::Block(_)))
+            .collect();
+        assert_eq!(kinds, [false, false, true]);
+        // At θ = 1 the slider is at x = r cos θ + √(L² − r² sin² θ); massless, at rest, the
+        // driver's torque τ balances the push: τ δθ + F δx = 0, τ = 100 dx/dθ.
+        let (r, l, theta) = (40.0_f64, 100.0_f64, 1.0_f64);
+        let (s, c) = theta.sin_cos();
+        let root = (l * l - r * r * s * s).sqrt();
+        let x = r * c + root;
+        let dx = -r * s - r * r * s * c / root;
+        let q = [0.0, 0.0, 0.0, 0.0, 0.0, theta, x, 0.0, 0.0];
+        let lambda = multipliers(&scene, &q);
+        let forces = scene.forces.as_ref().expect("forces");
+        let effort = value(&scene.model.arena, forces.reactions[8], &q, &lambda);
+        assert!(
+            (effort - 100.0 * dx).abs() < 1e-9,
+            "{effort} ≠ {}",
+            100.0 * dx
+        );
+        // The link pushes the slider with 100 along x: its tension 2 L λ is −100 / cos of the
+        // link's angle to the guide.
+        let tension = value(&scene.model.arena, forces.reactions[5], &q, &lambda);
+        let cos_link = (x - r * c) / l;
+        assert!((tension + 100.0 / cos_link).abs() < 1e-9, "{tension}");
+    }
+
+    #[test]
+    fn each_joint_reports_its_multiplier_by_its_convention() {
+        let scene = compile(CRANK_AND_LINK);
+        let forces = scene.forces.as_ref().expect("forces");
+        let q = [0.0, 0.0, 0.0, 0.0, 0.0, 1.0, 130.0, 0.0, 0.0];
+        let lambda: Vec<f64> = (1..=9).map(f64::from).collect();
+        let reported: Vec<f64> = forces.reactions[3..]
+            .iter()
+            .map(|&id| value(&scene.model.arena, id, &q, &lambda))
+            .collect();
+        // A revolute's force on its first body −λ, a distance joint's tension 2 L λ, a
+        // prismatic joint's normal and torque λ, a driver's effort −λ.
+        assert_eq!(reported, [-4.0, -5.0, 1200.0, 7.0, 8.0, -9.0]);
+        assert_eq!(
+            scene.model.reaction_names()[3..],
+            [
+                "pivot.fx",
+                "pivot.fy",
+                "link.tension",
+                "guide.normal",
+                "guide.torque",
+                "spin.effort"
+            ]
+        );
+    }
+
+    #[test]
+    fn a_welds_fixed_stage_resolves_its_multipliers_in_dependency_order() {
+        // The arm is welded at its point (−2, 0) to the frame's (1, 0), pushed up by 10 at its
+        // point (2, 0), world (5, 0). One fixed stage, listed by coordinate: frame (0–2), then
+        // glue.x, glue.y, glue.angle (3–5). The angle's multiplier reads glue.y's (the weld
+        // point is off the arm's reference point, Φ_q[glue.y, θ_arm] = ±2): glue.y's must be
+        // resolved first, although the reverse of the stage's order would take the angle first.
+        let scene = compile(
+            "mechanism Welded {
+                ground frame at (0, 0, 0);
+                body arm near (3, 0, 0);
+                joint glue: weld(frame @ (1, 0), arm @ (-2, 0));
+                load push: force(arm @ (2, 0)) = (0, 10);
+            }",
+        );
+        let forces = scene.forces.as_ref().expect("forces");
+        let arena = &scene.model.arena;
+        let [ForceStage::Explicit(values)] = &forces.stages[..] else {
+            panic!("one explicit stage")
+        };
+        // No value reads a multiplier: the stage's own are substituted, and none come later.
+        for &v in values {
+            let lambdas = arena.variables(v);
+            assert!(
+                !lambdas.iter().any(|v| matches!(v, Var::Lambda(_))),
+                "{lambdas:?}"
+            );
+        }
+        let q = [0.0, 0.0, 0.0, 3.0, 0.0, 0.0];
+        let lambda = multipliers(&scene, &q);
+        // The joints read the frame's pose as constants: its own rows carry nothing.
+        assert_eq!([lambda[0], lambda[1], lambda[2]], [0.0; 3]);
+        // The weld's torque: the load's moment about the weld point (4 × 10), not about the
+        // arm's reference point (2 × 10, the angle's expression without glue.y's multiplier).
+        assert_eq!(lambda[5], 40.0);
+        // Reported: the frame's load (the push, and its moment 5 × 10 about the frame's
+        // origin), and the weld's force and torque on the frame.
+        let reported: Vec<f64> = (forces.reactions.iter())
+            .map(|&id| value(arena, id, &q, &lambda))
+            .collect();
+        assert_eq!(reported, [0.0, 10.0, 50.0, 0.0, 10.0, 40.0]);
+    }
 
     /// Issue 20's first scene: its fixed stage holds the prismatic joint's two equations.
     const PRISMATIC_TORQUE: &str = "mechanism PrismaticTorque {

@@ -772,3 +772,344 @@ fn ranks(permutation: &[usize]) -> Vec<usize> {
     }
     ranks
 }
+
+#[cfg(test)]
+mod tests {
+    use super::{Block, Phase, Stage, stage_coordinates};
+    use crate::expr::{Arena, Func, Id, Node, Var};
+    use crate::interpret::{Env, eval};
+
+    fn compile(source: &str) -> crate::Scene {
+        crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"))
+    }
+
+    /// A crank-rocker. Coordinates: frame 0–2, crank 3–5, coupler 6–8, rocker 9–11 (x, y, θ).
+    /// Equations: frame 0–2, crank_pivot 3–4, crank_pin 5–6, rocker_pin 7–8, rocker_pivot
+    /// 9–10, crank_angle 11.
+    fn four_bar(coupler_angle: f64, rocker_angle: f64) -> String {
+        format!(
+            "mechanism FourBar {{
+                ground frame at (0, 0, 0);
+                body crank near (0, 0, 0);
+                body coupler near (40, 0, {coupler_angle});
+                body rocker near (100, 0, {rocker_angle});
+                joint crank_pivot: revolute(frame, crank);
+                joint crank_pin: revolute(crank @ (40, 0), coupler);
+                joint rocker_pin: revolute(coupler @ (120, 0), rocker @ (80, 0));
+                joint rocker_pivot: revolute(rocker, frame @ (100, 0));
+                driver crank_angle: angle(crank) = 10 * t;
+            }}"
+        )
+    }
+
+    /// A slider-crank whose rod's angle alone is a block. Coordinates: frame 0–2, crank 3–5,
+    /// rod 6–8, slider 9–11. Equations: frame 0–2, pivot 3–4, crank_pin 5–6, wrist 7–8,
+    /// guide 9–10 (normal, angle), spin 11.
+    fn slider_crank(extra: &str) -> String {
+        format!(
+            "mechanism SliderCrank {{
+                ground frame at (0, 0, 0);
+                body crank near (0, 0, 0);
+                body rod near (40, 0, -0.2);
+                body slider near (140, 0, 0);
+                joint pivot: revolute(frame, crank);
+                joint crank_pin: revolute(crank @ (40, 0), rod);
+                joint wrist: revolute(rod @ (100, 0), slider);
+                joint guide: prismatic(frame, slider, along (1, 0));
+                driver spin: angle(crank) = 10 * t;
+                {extra}
+            }}"
+        )
+    }
+
+    /// (equation, coordinate) of each assignment of an explicit stage, in order.
+    fn pairs(stage: &Stage) -> Vec<(usize, usize)> {
+        match stage {
+            Stage::Explicit(assignments) => assignments
+                .iter()
+                .map(|a| (a.equation, a.coordinate))
+                .collect(),
+            Stage::Block(_) => panic!("a block where an explicit stage was expected"),
+        }
+    }
+
+    fn block(stage: &Stage) -> &Block {
+        match stage {
+            Stage::Block(block) => block,
+            Stage::Explicit(_) => panic!("an explicit stage where a block was expected"),
+        }
+    }
+
+    /// The node `f(q_k)`, which the scene must hold.
+    fn trig_of(arena: &Arena, f: Func, k: u32) -> Id {
+        let q = arena
+            .find(Node::Var(Var::Q(k)))
+            .expect("the scene reads q_k");
+        arena
+            .find(Node::Call(f, q))
+            .expect("the scene reads f(q_k)")
+    }
+
+    /// q with the four-bar's fixed coordinates at their values (the rest as given).
+    fn four_bar_state(crank: f64, coupler: [f64; 3], rocker: f64) -> Vec<f64> {
+        let [x, y, theta] = coupler;
+        vec![
+            0.0, 0.0, 0.0, 0.0, 0.0, crank, x, y, theta, 100.0, 0.0, rocker,
+        ]
+    }
+
+    #[test]
+    fn a_four_bar_is_fixed_then_explicit_then_one_block() {
+        let scene = compile(&four_bar(0.6, 1.1));
+        let plan = &scene.plan;
+        assert_eq!(plan.stages.len(), 3);
+        // The frame and both pivots are constants, listed by coordinate.
+        assert_eq!(
+            pairs(&plan.stages[0]),
+            [(0, 0), (1, 1), (2, 2), (3, 3), (4, 4), (9, 9), (10, 10)]
+        );
+        // The driven crank angle, then the crank pin placing the coupler: one explicit stage.
+        assert_eq!(pairs(&plan.stages[1]), [(11, 5), (5, 6), (6, 7)]);
+        // The rocker pin closes the loop: both angles at once.
+        let b = block(&plan.stages[2]);
+        let (mut equations, mut coordinates) = (b.equations.clone(), b.coordinates.clone());
+        equations.sort_unstable();
+        coordinates.sort_unstable();
+        assert_eq!((equations, coordinates), (vec![7, 8], vec![8, 11]));
+        assert_eq!(plan.blocks().count(), 1);
+        assert_eq!(plan.assignments().count(), 10);
+        assert_eq!((plan.largest_block(), plan.largest_slots()), (2, 4));
+        // Every coordinate is solved by exactly one stage.
+        let mut solved: Vec<usize> = plan.stages.iter().flat_map(stage_coordinates).collect();
+        solved.sort_unstable();
+        assert_eq!(solved, (0..12).collect::<Vec<_>>());
+        // The fixed values are substituted: only the block reads an earlier stage (the coupler's
+        // x and y, from stage 1).
+        assert_eq!(plan.reads, [vec![], vec![], vec![1]]);
+    }
+
+    #[test]
+    fn explicit_assignments_are_closed_forms_of_earlier_values() {
+        let scene = compile(&four_bar(0.6, 1.1));
+        let arena = &scene.model.arena;
+        let Stage::Explicit(fixed) = &scene.plan.stages[0] else {
+            panic!("the fixed stage comes first")
+        };
+        for a in fixed {
+            let expected = if a.coordinate == 9 { 100.0 } else { 0.0 };
+            assert_eq!(
+                arena.as_const(a.position),
+                Some(expected),
+                "{}",
+                a.coordinate
+            );
+            assert!(arena.is_zero(a.velocity.expect("velocities")));
+            assert!(arena.is_zero(a.acceleration.expect("accelerations")));
+        }
+        let Stage::Explicit(stage) = &scene.plan.stages[1] else {
+            panic!("the crank and the coupler's pin are explicit")
+        };
+        // Each position reads only t: the crank's angle, assigned earlier in the stage, is
+        // substituted into the coupler's.
+        for a in stage {
+            assert_eq!(arena.variables(a.position), [Var::T], "{}", a.coordinate);
+        }
+        // At t = 0.1 the crank is at 1 rad turning at 10 rad/s: the coupler's reference point
+        // is the crank pin, 40 (cos, sin) of it.
+        let angle = 1.0_f64;
+        let env = Env {
+            q: four_bar_state(angle, [0.0; 3], 0.0),
+            qd: vec![0.0; 12],
+            qdd: vec![0.0; 12],
+            t: 0.1,
+            params: Vec::new(),
+        };
+        let (s, c) = angle.sin_cos();
+        let expected = [
+            [angle, 10.0, 0.0],
+            [40.0 * c, -400.0 * s, -4000.0 * c],
+            [40.0 * s, 400.0 * c, -4000.0 * s],
+        ];
+        for (a, expected) in stage.iter().zip(expected) {
+            let rates = [a.velocity, a.acceleration].map(|r| r.expect("rates"));
+            let values = [a.position, rates[0], rates[1]].map(|id| eval(arena, id, &env));
+            for (value, expected) in values.into_iter().zip(expected) {
+                assert!((value - expected).abs() < 1e-9, "{value} ≠ {expected}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_block_is_the_scenes_rows_and_columns_in_pivot_order() {
+        let scene = compile(&four_bar(0.6, 1.1));
+        let b = block(&scene.plan.stages[2]);
+        let arena = &scene.model.arena;
+        let env = Env {
+            q: four_bar_state(0.3, [40.0 * 0.3_f64.cos(), 40.0 * 0.3_f64.sin(), 0.5], 1.2),
+            ..Env::default()
+        };
+        for (r, &i) in b.equations.iter().enumerate() {
+            let (residual, textbook) = (b.residuals[r], scene.kinematics.phi[i]);
+            assert!((eval(arena, residual, &env) - eval(arena, textbook, &env)).abs() < 1e-12);
+        }
+        // Dense 2 × 2, column-major, each entry Φ_q at its (equation, coordinate).
+        let positions: Vec<(usize, usize)> = b.entries.iter().map(|e| (e.0, e.1)).collect();
+        assert_eq!(positions, [(0, 0), (1, 0), (0, 1), (1, 1)]);
+        for &(r, c, value) in &b.entries {
+            let (row, col) = (b.equations[r], b.coordinates[c]);
+            let textbook = scene.kinematics.jacobian.iter();
+            let textbook = textbook
+                .filter(|e| (e.row, e.col) == (row, col))
+                .map(|e| e.value)
+                .next()
+                .expect("a structural non-zero of Φ_q");
+            let (planned, textbook) = (eval(arena, value, &env), eval(arena, textbook, &env));
+            assert!((planned - textbook).abs() < 1e-12, "({row}, {col})");
+        }
+        let lu = b.factorization.as_ref().expect("a static LU");
+        assert_eq!((lu.n, lu.entries, lu.slots), (2, 4, 4));
+    }
+
+    #[test]
+    fn the_pivot_order_follows_the_initial_guess() {
+        // ∂(rocker_pin)/∂(θ_coupler, θ_rocker) = 120 (−sin, cos) θc and 80 (sin, −cos) θr, up to
+        // sign. At (0.6, 1.1) the largest of each column relative to its column are y/θc and
+        // x/θr, and the first row wins: x pivots on the rocker. At (1.5, 0.2) they are x/θc and
+        // y/θr: x pivots on the coupler.
+        for ((coupler, rocker), first) in [((0.6, 1.1), 11), ((1.5, 0.2), 8)] {
+            let scene = compile(&four_bar(coupler, rocker));
+            let b = block(&scene.plan.stages[2]);
+            assert_eq!(b.equations, [7, 8], "rows: rocker_pin.x, then .y");
+            let second = if first == 11 { 8 } else { 11 };
+            assert_eq!(
+                b.coordinates,
+                [first, second],
+                "guess ({coupler}, {rocker})"
+            );
+        }
+    }
+
+    #[test]
+    fn a_slider_crank_caches_the_angles_read_after_their_stage() {
+        let scene = compile(&slider_crank(""));
+        let plan = &scene.plan;
+        // Fixed (frame, crank pivot, slider's y and θ), explicit (crank, rod pin), the rod's
+        // angle alone (wrist.y is not affine in it), then the slider's x.
+        assert_eq!(
+            pairs(&plan.stages[0]),
+            [(0, 0), (1, 1), (2, 2), (3, 3), (4, 4), (9, 10), (10, 11)]
+        );
+        assert_eq!(pairs(&plan.stages[1]), [(11, 5), (5, 6), (6, 7)]);
+        let b = block(&plan.stages[2]);
+        assert_eq!((&b.equations[..], &b.coordinates[..]), (&[8][..], &[8][..]));
+        assert_eq!(pairs(&plan.stages[3]), [(7, 9)]);
+        assert_eq!(plan.reads, [vec![], vec![], vec![1], vec![1, 2]]);
+        // The crank's sine (its stage's rates) and the rod's cosine (the slider's position):
+        // slots of two, filled by the angle's stage.
+        let trig = &plan.trig;
+        assert_eq!(trig.angles, [5, 8]);
+        assert_eq!(trig.filled_by, [1, 2]);
+        assert_eq!(
+            (trig.len(), trig.fills(2).collect::<Vec<_>>()),
+            (4, vec![1])
+        );
+        let arena = &scene.model.arena;
+        for (m, &k) in trig.angles.iter().enumerate() {
+            let k = k as u32;
+            let (sin, cos) = (trig_of(arena, Func::Sin, k), trig_of(arena, Func::Cos, k));
+            assert_eq!(trig.nodes[m], (sin, cos));
+            assert_eq!((trig.slot[&sin], trig.slot[&cos]), (2 * m, 2 * m + 1));
+        }
+    }
+
+    #[test]
+    fn a_kernel_reads_the_cache_once_its_angle_is_solved() {
+        let scene = compile(&slider_crank(""));
+        let (plan, arena) = (&scene.plan, &scene.model.arena);
+        let sin_rod = trig_of(arena, Func::Sin, 8);
+        let b = block(&plan.stages[2]);
+        // The block's residual reads sin θ_rod while solving for it: computed, not cached.
+        let residual = &b.residuals;
+        assert!(
+            plan.trig
+                .reads(arena, residual, 2, Phase::Positions)
+                .is_empty()
+        );
+        let after = plan.trig.reads(arena, residual, 2, Phase::After);
+        assert_eq!(after.into_iter().collect::<Vec<_>>(), [(sin_rod, 2)]);
+        let last = plan.trig.reads(arena, residual, 2, Phase::Final);
+        assert_eq!(last.into_iter().collect::<Vec<_>>(), [(sin_rod, 2)]);
+        // The slider's x, a stage later, reads the rod's cosine from the cache.
+        let Stage::Explicit(slider) = &plan.stages[3] else {
+            panic!("the slider's x is explicit")
+        };
+        let cos_rod = trig_of(arena, Func::Cos, 8);
+        let position = plan
+            .trig
+            .reads(arena, &[slider[0].position], 3, Phase::Positions);
+        assert_eq!(position.into_iter().collect::<Vec<_>>(), [(cos_rod, 3)]);
+    }
+
+    #[test]
+    fn only_what_a_scene_computes_is_cached() {
+        // Positions only: no rates read the crank's sine; the slider still reads the rod's cosine.
+        let positions = compile(&slider_crank("outputs positions;"));
+        assert_eq!(positions.plan.trig.angles, [8]);
+        assert_eq!(positions.plan.trig.filled_by, [2]);
+        // A marker on the crank, evaluated after the sweep, reads the crank's angle too.
+        let marker = compile(&slider_crank(
+            "outputs positions; marker tip: crank @ (40, 0);",
+        ));
+        assert_eq!(marker.plan.trig.angles, [5, 8]);
+        assert_eq!(marker.plan.trig.filled_by, [1, 2]);
+    }
+
+    #[test]
+    fn fixing_repeats_until_substitution_reveals_nothing_more() {
+        // The weld's x and y read the arm's angle through its point (−2, 0): they fix the arm's
+        // x and y only once its angle is fixed, on the second pass. Listed by coordinate.
+        let scene = compile(
+            "mechanism Welded {
+                ground frame at (0, 0, 0);
+                body arm near (3, 0, 0);
+                joint glue: weld(frame @ (1, 0), arm @ (-2, 0));
+            }",
+        );
+        let plan = &scene.plan;
+        assert_eq!(plan.stages.len(), 1);
+        let pairs = pairs(&plan.stages[0]);
+        assert_eq!(pairs, [(0, 0), (1, 1), (2, 2), (3, 3), (4, 4), (5, 5)]);
+        let arena = &scene.model.arena;
+        let positions: Vec<Option<f64>> = plan
+            .assignments()
+            .map(|a| arena.as_const(a.position))
+            .collect();
+        assert_eq!(positions, [0.0, 0.0, 0.0, 3.0, 0.0, 0.0].map(Some));
+    }
+
+    #[test]
+    fn the_naive_baseline_is_one_block_of_everything() {
+        let options = crate::CodegenOptions {
+            naive: true,
+            ..crate::CodegenOptions::default()
+        };
+        let scene = crate::compile_str_with(&four_bar(0.6, 1.1), &options)
+            .unwrap_or_else(|e| panic!("{e}"));
+        let plan = &scene.plan;
+        assert_eq!(plan.stages.len(), 1);
+        let b = block(&plan.stages[0]);
+        assert_eq!(b.equations, (0..12).collect::<Vec<_>>());
+        assert_eq!(b.coordinates, (0..12).collect::<Vec<_>>());
+        assert!(b.factorization.is_none());
+        assert_eq!(b.slots(), scene.kinematics.jacobian.len());
+        // Column-major, as the runtime's partial-pivoting factorisation reads them.
+        assert!(
+            b.entries
+                .windows(2)
+                .all(|w| (w[0].1, w[0].0) < (w[1].1, w[1].0))
+        );
+        assert_eq!(plan.reads, [Vec::<usize>::new()]);
+        assert!(plan.trig.is_empty());
+        assert_eq!(plan.largest_block(), 12);
+    }
+}

@@ -142,41 +142,10 @@ impl Context<'_> {
             .filter(|(i, _)| !outs.iter().any(|(o, _)| o == i))
             .collect();
         for (k, group) in groups.iter().enumerate() {
-            // Only the outputs this part writes (a Φ part of `phi_and_jacobian` takes no Φ_q).
-            let written: Vec<&(&str, TokenStream)> = outs
-                .iter()
-                .filter(|(o, _)| group.iter().any(|(target, _)| writes_to(target, o)))
-                .collect();
-            let out_names: Vec<Ident> = written
-                .iter()
-                .map(|(o, _)| format_ident!("{}", o))
-                .collect();
-            let out_types: Vec<&TokenStream> = written.iter().map(|(_, ty)| ty).collect();
-            let part = self.function(group, TokenStream::new(), cached);
-            counts = counts + part.counts;
-            let params = inputs.iter().map(|(i, ty)| {
-                let ident = part.args.get(i);
-                quote!(#ident: #ty,)
-            });
-            let arguments = inputs.iter().map(|(i, _)| {
-                let ident = format_ident!("{}", i);
-                quote!(#ident,)
-            });
-            let t = &part.args.t;
             let part_name = format_ident!("{}_part{}", name, k);
-            let body = part.body;
-            self.helpers.borrow_mut().push(quote! {
-                #[inline(never)]
-                fn #part_name(
-                    &self,
-                    #(#params)*
-                    #t: f64,
-                    #(#out_names: #out_types),*
-                ) {
-                    #body
-                }
-            });
-            calls.push(quote! { self.#part_name(#(#arguments)* t, #(#out_names),*); });
+            let (call, part_counts) = self.part(&part_name, group, outs, &inputs, cached);
+            counts = counts + part_counts;
+            calls.push(call);
         }
         let used =
             |i: &str| inputs.iter().any(|(n, _)| *n == i) || outs.iter().any(|(o, _)| *o == i);
@@ -192,6 +161,52 @@ impl Context<'_> {
             }),
             counts,
         }
+    }
+
+    /// One part of a split body: its helper method, writing the outputs `group` (pushed to
+    /// the helpers), and the statement calling it with `inputs` and the `outs` it writes.
+    fn part(
+        &self,
+        part_name: &Ident,
+        group: &[(TokenStream, Id)],
+        outs: &[(&str, TokenStream)],
+        inputs: &[&(&str, TokenStream)],
+        cached: &HashMap<Id, usize>,
+    ) -> (TokenStream, OpCounts) {
+        // Only the outputs this part writes (a Φ part of `phi_and_jacobian` takes no Φ_q).
+        let written: Vec<&(&str, TokenStream)> = outs
+            .iter()
+            .filter(|(o, _)| group.iter().any(|(target, _)| writes_to(target, o)))
+            .collect();
+        let out_names: Vec<Ident> = written
+            .iter()
+            .map(|(o, _)| format_ident!("{}", o))
+            .collect();
+        let out_types: Vec<&TokenStream> = written.iter().map(|(_, ty)| ty).collect();
+        let part = self.function(group, TokenStream::new(), cached);
+        let params = inputs.iter().map(|(i, ty)| {
+            let ident = part.args.get(i);
+            quote!(#ident: #ty,)
+        });
+        let arguments = inputs.iter().map(|(i, _)| {
+            let ident = format_ident!("{}", i);
+            quote!(#ident,)
+        });
+        let t = &part.args.t;
+        let body = &part.body;
+        self.helpers.borrow_mut().push(quote! {
+            #[inline(never)]
+            fn #part_name(
+                &self,
+                #(#params)*
+                #t: f64,
+                #(#out_names: #out_types),*
+            ) {
+                #body
+            }
+        });
+        let call = quote! { self.#part_name(#(#arguments)* t, #(#out_names),*); };
+        (call, part.counts)
     }
 
     /// `::mechgen_runtime::Vector<Const<N>>` for this scene.
@@ -251,209 +266,16 @@ impl Context<'_> {
             .collect();
         let roots: Vec<Id> = nonzero.iter().map(|(_, id)| *id).collect();
         let order = topological_order_with(arena, &roots, |id| cached.contains_key(&id));
-
-        let mut uses: HashMap<Id, usize> = HashMap::with_capacity(order.len());
-        for &id in &order {
-            for child in arena.children(id) {
-                *uses.entry(child).or_insert(0) += 1;
-            }
-        }
-        for &id in &roots {
-            *uses.entry(id).or_insert(0) += 1;
-        }
-
-        let mut names = Names::default();
-        let mut bound: HashMap<Id, Ident> = HashMap::new();
-        let mut rendered: HashMap<Id, (TokenStream, Prec)> = HashMap::new();
-        let mut lets = Vec::new();
-        // Coordinate loads go first, in q order, then the cached trig: the reader sees the
-        // inputs, then the work.
-        let mut loads: Vec<(Var, TokenStream)> = Vec::new();
-        let mut trig_loads: Vec<(usize, TokenStream)> = Vec::new();
-        let mut funcs = BTreeSet::new();
-        let mut reads = Reads::default();
         let counts = if self.options.naive {
             OpCounts::of_tree(arena, &roots)
         } else {
             OpCounts::of(arena, &order)
         };
-
-        // sin(x) and cos(x) of one argument come from one `sincos(x)`: one argument reduction.
-        let in_order: HashSet<Id> = order.iter().copied().collect();
-        let partner = |id: Id| {
-            match arena.node(id) {
-                Node::Call(Func::Sin, a) => arena.find(Node::Call(Func::Cos, a)),
-                Node::Call(Func::Cos, a) => arena.find(Node::Call(Func::Sin, a)),
-                _ => None,
-            }
-            .filter(|p| in_order.contains(p) && !cached.contains_key(p) && !self.options.naive)
-        };
-
+        let mut writer = Writer::new(self, &order, &roots, cached);
         for &id in &order {
-            if bound.contains_key(&id) {
-                // The second of a sin/cos pair, bound with the first.
-                continue;
-            }
-            if let Some(&i) = cached.get(&id) {
-                let ident = names.fresh(&self.suggest(id));
-                let i_lit = idx(i);
-                trig_loads.push((i, quote! { let #ident = trig[#i_lit]; }));
-                bound.insert(id, ident);
-                continue;
-            }
-            let node = arena.node(id);
-            if let (Some(other), Node::Call(f, a)) = (partner(id), node) {
-                let (sin, cos) = if f == Func::Sin {
-                    (id, other)
-                } else {
-                    (other, id)
-                };
-                let argument = match bound.get(&a) {
-                    Some(ident) => quote!(#ident),
-                    None => rendered.get(&a).map_or(quote!(0.0), |(t, _)| t.clone()),
-                };
-                let (s, c) = (
-                    names.fresh(&self.suggest(sin)),
-                    names.fresh(&self.suggest(cos)),
-                );
-                funcs.insert("sincos");
-                lets.push(quote! { let (#s, #c) = sincos(#argument); });
-                bound.insert(sin, s);
-                bound.insert(cos, c);
-                continue;
-            }
-            let operand = |x: Id| -> (TokenStream, Prec) {
-                match bound.get(&x) {
-                    Some(ident) => (quote!(#ident), Prec::Atom),
-                    None => rendered
-                        .get(&x)
-                        .cloned()
-                        .unwrap_or_else(|| (quote!(0.0), Prec::Atom)),
-                }
-            };
-            let load = |vector: &str, k: u32| {
-                let (vector, k) = (format_ident!("{}", vector), idx(k as usize));
-                (quote!(#vector[#k]), Prec::Atom)
-            };
-            let (tokens, prec) = match node {
-                Node::Const(bits) => {
-                    let value = f64::from_bits(bits);
-                    // Negative literals are written `-c` and parenthesised like a sum in operands.
-                    let prec = if value < 0.0 { Prec::Sum } else { Prec::Atom };
-                    (f64_literal(value), prec)
-                }
-                Node::Param(i) => {
-                    let name = &self.model.params[i as usize].name;
-                    (quote!(self.#name), Prec::Atom)
-                }
-                Node::Var(Var::T) => {
-                    reads.t = true;
-                    (quote!(t), Prec::Atom)
-                }
-                Node::Var(Var::Q(k)) => {
-                    reads.q = true;
-                    load("q", k)
-                }
-                Node::Var(Var::Qd(k)) => {
-                    reads.qd = true;
-                    load("qd", k)
-                }
-                Node::Var(Var::Qdd(k)) => {
-                    reads.qdd = true;
-                    load("qdd", k)
-                }
-                Node::Var(Var::Lambda(i)) => {
-                    reads.lambda = true;
-                    load("lambda", i)
-                }
-                Node::Neg(a) => {
-                    let a = operand(a).wrap(Prec::Unary);
-                    (quote!(-#a), Prec::Unary)
-                }
-                Node::Add(a, b) => binary(operand(a), quote!(+), operand(b), Prec::Sum),
-                Node::Sub(a, b) => binary(operand(a), quote!(-), operand(b), Prec::Sum),
-                Node::Mul(a, b) => binary(operand(a), quote!(*), operand(b), Prec::Product),
-                Node::Div(a, b) => binary(operand(a), quote!(/), operand(b), Prec::Product),
-                Node::Powi(a, n) => {
-                    funcs.insert("powi");
-                    let a = operand(a).0;
-                    (quote!(powi(#a, #n)), Prec::Atom)
-                }
-                Node::Call(f, a) => {
-                    funcs.insert(f.name());
-                    let f_ident = format_ident!("{}", f.name());
-                    let a = operand(a).0;
-                    (quote!(#f_ident(#a)), Prec::Atom)
-                }
-                Node::Call2(f, a, b) => {
-                    funcs.insert(f.name());
-                    let f_ident = format_ident!("{}", f.name());
-                    let (a, b) = (operand(a).0, operand(b).0);
-                    (quote!(#f_ident(#a, #b)), Prec::Atom)
-                }
-                Node::Select(a, b, x, y) => {
-                    funcs.insert("select");
-                    let [a, b, x, y] = [a, b, x, y].map(|o| operand(o).0);
-                    (quote!(select(#a, #b, #x, #y)), Prec::Atom)
-                }
-                Node::Spline { table, order, x } => {
-                    let table = format_ident!("SPLINE_{}", table);
-                    let order = Literal::u8_unsuffixed(order);
-                    let x = operand(x).0;
-                    (quote!(Self::#table.eval(#x, #order)), Prec::Atom)
-                }
-            };
-            let is_leaf = matches!(node, Node::Const(_) | Node::Param(_) | Node::Var(Var::T));
-            // Coordinates are loaded once; the naive baseline shares nothing else.
-            let call = matches!(node, Node::Call(..) | Node::Call2(..) | Node::Spline { .. });
-            let shared = call || uses.get(&id).copied().unwrap_or(0) > 1;
-            let bind =
-                !is_leaf && (matches!(node, Node::Var(_)) || (shared && !self.options.naive));
-            if bind {
-                let ident = names.fresh(&self.suggest(id));
-                let statement = quote! { let #ident = #tokens; };
-                match node {
-                    Node::Var(v) => loads.push((v, statement)),
-                    _ => lets.push(statement),
-                }
-                bound.insert(id, ident);
-            } else {
-                rendered.insert(id, (tokens, prec));
-            }
+            writer.statement(id);
         }
-
-        let writes = nonzero.iter().map(|(target, id)| {
-            let value = match bound.get(id) {
-                Some(ident) => quote!(#ident),
-                None => rendered
-                    .get(id)
-                    .cloned()
-                    .map_or_else(|| quote!(0.0), |(t, _)| t),
-            };
-            if target.is_empty() {
-                value
-            } else {
-                quote! { #target = #value; }
-            }
-        });
-        let imports = if funcs.is_empty() {
-            TokenStream::new()
-        } else {
-            let funcs = funcs.iter().map(|f| format_ident!("{}", f));
-            quote! { use ::mechgen_runtime::math::{#(#funcs),*}; }
-        };
-        loads.sort_by_key(|(v, _)| *v);
-        trig_loads.sort_by_key(|(i, _)| *i);
-        reads.trig = !trig_loads.is_empty();
-        let loads = loads
-            .into_iter()
-            .map(|(_, statement)| statement)
-            .chain(trig_loads.into_iter().map(|(_, statement)| statement));
-        Function {
-            body: quote! { #imports #(#loads)* #(#lets)* #clear #(#writes)* },
-            args: Args::named(reads),
-            counts,
-        }
+        writer.finish(&nonzero, clear, counts)
     }
 
     /// A readable name for a bound node: `rod_theta`, `sin_rod_theta`, `piston_x_dot`, or `e`.
@@ -506,6 +328,271 @@ fn new_nodes(
         }
         fresh.push(id);
         stack.extend(arena.children(id));
+    }
+}
+
+/// One body being written, node by node in topological order: what each node became (a bound
+/// local or inline tokens), the statements so far, and which inputs and functions it reads.
+struct Writer<'w, 'a> {
+    cx: &'w Context<'a>,
+    /// The nodes read from the trig cache, with their slots.
+    cached: &'w HashMap<Id, usize>,
+    /// How often each node is read, by the body's nodes and as an output.
+    uses: HashMap<Id, usize>,
+    /// The body's nodes, for pairing `sin(x)` with `cos(x)`.
+    in_order: HashSet<Id>,
+    names: Names,
+    bound: HashMap<Id, Ident>,
+    rendered: HashMap<Id, (TokenStream, Prec)>,
+    lets: Vec<TokenStream>,
+    // Coordinate loads go first, in q order, then the cached trig: the reader sees the
+    // inputs, then the work.
+    loads: Vec<(Var, TokenStream)>,
+    trig_loads: Vec<(usize, TokenStream)>,
+    funcs: BTreeSet<&'static str>,
+    reads: Reads,
+}
+
+impl<'w, 'a> Writer<'w, 'a> {
+    /// A writer for the nodes `order` (topological) computing `roots`.
+    fn new(
+        cx: &'w Context<'a>,
+        order: &[Id],
+        roots: &[Id],
+        cached: &'w HashMap<Id, usize>,
+    ) -> Self {
+        let arena = cx.arena();
+        let mut uses: HashMap<Id, usize> = HashMap::with_capacity(order.len());
+        for &id in order {
+            for child in arena.children(id) {
+                *uses.entry(child).or_insert(0) += 1;
+            }
+        }
+        for &id in roots {
+            *uses.entry(id).or_insert(0) += 1;
+        }
+        Writer {
+            cx,
+            cached,
+            uses,
+            in_order: order.iter().copied().collect(),
+            names: Names::default(),
+            bound: HashMap::new(),
+            rendered: HashMap::new(),
+            lets: Vec::new(),
+            loads: Vec::new(),
+            trig_loads: Vec::new(),
+            funcs: BTreeSet::new(),
+            reads: Reads::default(),
+        }
+    }
+
+    /// Node `id`'s statement, or its inline tokens (its operands come before it in order).
+    fn statement(&mut self, id: Id) {
+        if self.bound.contains_key(&id) {
+            // The second of a sin/cos pair, bound with the first.
+            return;
+        }
+        if let Some(&i) = self.cached.get(&id) {
+            let ident = self.fresh(id);
+            let i_lit = idx(i);
+            self.trig_loads
+                .push((i, quote! { let #ident = trig[#i_lit]; }));
+            self.bound.insert(id, ident);
+            return;
+        }
+        let node = self.cx.arena().node(id);
+        if let (Some(other), Node::Call(f, a)) = (self.partner(id), node) {
+            self.sincos(id, other, f, a);
+            return;
+        }
+        let (tokens, prec) = self.render(node);
+        let is_leaf = matches!(node, Node::Const(_) | Node::Param(_) | Node::Var(Var::T));
+        // Coordinates are loaded once; the naive baseline shares nothing else.
+        let call = matches!(node, Node::Call(..) | Node::Call2(..) | Node::Spline { .. });
+        let shared = call || self.uses.get(&id).copied().unwrap_or(0) > 1;
+        let bind = !is_leaf && (matches!(node, Node::Var(_)) || (shared && !self.cx.options.naive));
+        if bind {
+            let ident = self.fresh(id);
+            let statement = quote! { let #ident = #tokens; };
+            match node {
+                Node::Var(v) => self.loads.push((v, statement)),
+                _ => self.lets.push(statement),
+            }
+            self.bound.insert(id, ident);
+        } else {
+            self.rendered.insert(id, (tokens, prec));
+        }
+    }
+
+    /// A fresh local named after node `id`.
+    fn fresh(&mut self, id: Id) -> Ident {
+        self.names.fresh(&self.cx.suggest(id))
+    }
+
+    /// The cos of a sin node (or the sin of a cos) when the body computes both: sin(x) and
+    /// cos(x) of one argument come from one `sincos(x)`, one argument reduction.
+    fn partner(&self, id: Id) -> Option<Id> {
+        let arena = self.cx.arena();
+        match arena.node(id) {
+            Node::Call(Func::Sin, a) => arena.find(Node::Call(Func::Cos, a)),
+            Node::Call(Func::Cos, a) => arena.find(Node::Call(Func::Sin, a)),
+            _ => None,
+        }
+        .filter(|p| {
+            self.in_order.contains(p) && !self.cached.contains_key(p) && !self.cx.options.naive
+        })
+    }
+
+    /// Binds `f(a)` (sin or cos) at `id` and its partner `other` from one `sincos(a)`.
+    fn sincos(&mut self, id: Id, other: Id, f: Func, a: Id) {
+        let (sin, cos) = if f == Func::Sin {
+            (id, other)
+        } else {
+            (other, id)
+        };
+        let argument = self.operand(a).0;
+        let (s, c) = (self.fresh(sin), self.fresh(cos));
+        self.funcs.insert("sincos");
+        self.lets.push(quote! { let (#s, #c) = sincos(#argument); });
+        self.bound.insert(sin, s);
+        self.bound.insert(cos, c);
+    }
+
+    /// An operand: its local if bound, its tokens otherwise.
+    fn operand(&self, x: Id) -> (TokenStream, Prec) {
+        match self.bound.get(&x) {
+            Some(ident) => (quote!(#ident), Prec::Atom),
+            None => self
+                .rendered
+                .get(&x)
+                .cloned()
+                .unwrap_or_else(|| (quote!(0.0), Prec::Atom)),
+        }
+    }
+
+    /// The expression computing `node` from its operands, and how strongly it binds.
+    fn render(&mut self, node: Node) -> (TokenStream, Prec) {
+        match node {
+            Node::Const(bits) => {
+                let value = f64::from_bits(bits);
+                // Negative literals are written `-c` and parenthesised like a sum in operands.
+                let prec = if value < 0.0 { Prec::Sum } else { Prec::Atom };
+                (f64_literal(value), prec)
+            }
+            Node::Param(i) => {
+                let name = &self.cx.model.params[i as usize].name;
+                (quote!(self.#name), Prec::Atom)
+            }
+            Node::Var(v) => self.variable(v),
+            Node::Neg(a) => {
+                let a = self.operand(a).wrap(Prec::Unary);
+                (quote!(-#a), Prec::Unary)
+            }
+            Node::Add(a, b) => binary(self.operand(a), quote!(+), self.operand(b), Prec::Sum),
+            Node::Sub(a, b) => binary(self.operand(a), quote!(-), self.operand(b), Prec::Sum),
+            Node::Mul(a, b) => binary(self.operand(a), quote!(*), self.operand(b), Prec::Product),
+            Node::Div(a, b) => binary(self.operand(a), quote!(/), self.operand(b), Prec::Product),
+            Node::Powi(a, n) => {
+                self.funcs.insert("powi");
+                let a = self.operand(a).0;
+                (quote!(powi(#a, #n)), Prec::Atom)
+            }
+            Node::Call(f, a) => {
+                self.funcs.insert(f.name());
+                let f_ident = format_ident!("{}", f.name());
+                let a = self.operand(a).0;
+                (quote!(#f_ident(#a)), Prec::Atom)
+            }
+            Node::Call2(f, a, b) => {
+                self.funcs.insert(f.name());
+                let f_ident = format_ident!("{}", f.name());
+                let (a, b) = (self.operand(a).0, self.operand(b).0);
+                (quote!(#f_ident(#a, #b)), Prec::Atom)
+            }
+            Node::Select(a, b, x, y) => {
+                self.funcs.insert("select");
+                let [a, b, x, y] = [a, b, x, y].map(|o| self.operand(o).0);
+                (quote!(select(#a, #b, #x, #y)), Prec::Atom)
+            }
+            Node::Spline { table, order, x } => {
+                let table = format_ident!("SPLINE_{}", table);
+                let order = Literal::u8_unsuffixed(order);
+                let x = self.operand(x).0;
+                (quote!(Self::#table.eval(#x, #order)), Prec::Atom)
+            }
+        }
+    }
+
+    /// An input: `t`, or an element of `q`, `qd`, `qdd` or `lambda` (noted as read).
+    fn variable(&mut self, v: Var) -> (TokenStream, Prec) {
+        let load = |vector: &str, k: u32| {
+            let (vector, k) = (format_ident!("{}", vector), idx(k as usize));
+            (quote!(#vector[#k]), Prec::Atom)
+        };
+        match v {
+            Var::T => {
+                self.reads.t = true;
+                (quote!(t), Prec::Atom)
+            }
+            Var::Q(k) => {
+                self.reads.q = true;
+                load("q", k)
+            }
+            Var::Qd(k) => {
+                self.reads.qd = true;
+                load("qd", k)
+            }
+            Var::Qdd(k) => {
+                self.reads.qdd = true;
+                load("qdd", k)
+            }
+            Var::Lambda(i) => {
+                self.reads.lambda = true;
+                load("lambda", i)
+            }
+        }
+    }
+
+    /// The body: the math imports, the input loads (q order, then trig slots), the shared
+    /// values, `clear`, then the writes of `outputs`.
+    fn finish(
+        mut self,
+        outputs: &[&(TokenStream, Id)],
+        clear: TokenStream,
+        counts: OpCounts,
+    ) -> Function {
+        let writes: Vec<TokenStream> = outputs
+            .iter()
+            .map(|(target, id)| {
+                let value = self.operand(*id).0;
+                if target.is_empty() {
+                    value
+                } else {
+                    quote! { #target = #value; }
+                }
+            })
+            .collect();
+        let imports = if self.funcs.is_empty() {
+            TokenStream::new()
+        } else {
+            let funcs = self.funcs.iter().map(|f| format_ident!("{}", f));
+            quote! { use ::mechgen_runtime::math::{#(#funcs),*}; }
+        };
+        self.loads.sort_by_key(|(v, _)| *v);
+        self.trig_loads.sort_by_key(|(i, _)| *i);
+        self.reads.trig = !self.trig_loads.is_empty();
+        let loads = self
+            .loads
+            .into_iter()
+            .map(|(_, statement)| statement)
+            .chain(self.trig_loads.into_iter().map(|(_, statement)| statement));
+        let lets = self.lets;
+        Function {
+            body: quote! { #imports #(#loads)* #(#lets)* #clear #(#writes)* },
+            args: Args::named(self.reads),
+            counts,
+        }
     }
 }
 

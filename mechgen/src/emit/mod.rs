@@ -175,24 +175,12 @@ impl Context<'_> {
         let equation_names = model.equation_names();
         let param_names: Vec<String> = model.params.iter().map(|p| p.name.to_string()).collect();
         let param_count = idx(param_names.len());
-        let coordinate_consts = coordinate_names.iter().enumerate().map(|(i, c)| {
-            let ident = format_ident!("{}", c.replace('.', "_").to_uppercase());
-            let doc = format!(" Index of `{c}` in q.");
-            let i = idx(i);
-            quote! { #[doc = #doc] pub const #ident: usize = #i; }
-        });
+        let coordinate_consts = coordinate_indices(&coordinate_names);
         let jacobian_count = idx(kin.jacobian.len());
         let pattern = kin.jacobian.iter().map(|e| {
             let (r, c) = (idx(e.row), idx(e.col));
             quote! { (#r, #c) }
         });
-        let unit_list = |units: Vec<Unit>| {
-            let units = units.into_iter().map(|u| {
-                let variant = format_ident!("{}", u.name());
-                quote!(::mechgen_runtime::Unit::#variant)
-            });
-            quote!([#(#units),*])
-        };
         let coordinate_units = unit_list(model.coordinate_units());
         let equation_units = unit_list(model.equation_units());
         let branch_names = self.branch_names();
@@ -230,7 +218,7 @@ impl Context<'_> {
                 #splines
                 #marker_names
                 #names
-                #(#coordinate_consts)*
+                #coordinate_consts
             }
         }
     }
@@ -270,20 +258,9 @@ impl Context<'_> {
         let model = self.model;
         let name = &model.name;
         let n_lit = idx(model.dim());
-        let param_count = idx(model.params.len());
-        let param_reads = model.params.iter().enumerate().map(|(i, p)| {
-            let (i, name) = (idx(i), &p.name);
-            quote! { #i => ::core::option::Option::Some(self.#name), }
-        });
-        let param_writes = model.params.iter().map(|p| {
-            let (name, key) = (&p.name, p.name.to_string());
-            quote! {
-                #key => {
-                    self.#name = value;
-                    ::core::result::Result::Ok(())
-                }
-            }
-        });
+        let naming_methods = self.naming_methods();
+        let parameter_methods = self.parameter_methods();
+        let unit_methods = self.unit_methods();
         let length_scale = self.length_scale(kin);
         let check_geometry = self.check_method(&kin.geometry, checks::Checks::Geometry);
         let check_physics = self.check_method(&kin.physics, checks::Checks::Physics);
@@ -291,99 +268,14 @@ impl Context<'_> {
         let equations = self.textbook_functions(kin);
         let force_methods = self.forces.map(|forces| self.force_methods(forces));
         let marker_methods = self.marker_methods(self.markers);
-        let (outputs_variant, markers) = match model.outputs {
-            Outputs::Positions => (quote!(Positions), TokenStream::new()),
-            Outputs::Velocities => (
-                quote!(Velocities),
-                quote! { impl ::mechgen_runtime::Velocities for #name {} },
-            ),
-            Outputs::Accelerations => (
-                quote!(Accelerations),
-                quote! {
-                    impl ::mechgen_runtime::Velocities for #name {}
-                    impl ::mechgen_runtime::Accelerations for #name {}
-                },
-            ),
-            Outputs::Forces => (
-                quote!(Forces),
-                quote! {
-                    impl ::mechgen_runtime::Velocities for #name {}
-                    impl ::mechgen_runtime::Accelerations for #name {}
-                    impl ::mechgen_runtime::Forces for #name {}
-                },
-            ),
-        };
+        let (outputs_variant, markers) = self.level_markers();
         quote! {
             impl ::mechgen_runtime::Mechanism for #name {
                 type Dim = ::mechgen_runtime::nalgebra::Const<#n_lit>;
                 #marker_methods
-
-                fn dim(&self) -> Self::Dim {
-                    ::mechgen_runtime::nalgebra::Const::<#n_lit>
-                }
-
-                fn names(&self) -> &'static ::mechgen_runtime::Names {
-                    &Self::NAMES
-                }
-
-                fn coordinate_name(&self, index: usize) -> ::core::option::Option<&str> {
-                    Self::COORDINATES.get(index).copied()
-                }
-
-                fn equation_name(&self, index: usize) -> ::core::option::Option<&str> {
-                    Self::EQUATIONS.get(index).copied()
-                }
-
-                fn parameter_count(&self) -> usize {
-                    #param_count
-                }
-
-                fn parameter_name(&self, index: usize) -> ::core::option::Option<&str> {
-                    Self::PARAMETERS.get(index).copied()
-                }
-
-                fn parameter(&self, index: usize) -> ::core::option::Option<f64> {
-                    match index {
-                        #(#param_reads)*
-                        _ => ::core::option::Option::None,
-                    }
-                }
-
-                fn set_parameter<'a>(
-                    &'a mut self,
-                    name: &'a str,
-                    value: f64,
-                ) -> ::core::result::Result<(), ::mechgen_runtime::ParameterError<'a>> {
-                    if !value.is_finite() && Self::PARAMETERS.contains(&name) {
-                        return ::core::result::Result::Err(
-                            ::mechgen_runtime::ParameterError::NonFinite { name, value },
-                        );
-                    }
-                    match name {
-                        #(#param_writes)*
-                        _ => ::core::result::Result::Err(
-                            ::mechgen_runtime::ParameterError::Unknown {
-                                name,
-                                declared: &Self::PARAMETERS,
-                            },
-                        ),
-                    }
-                }
-
-                fn coordinate_unit(&self, index: usize) -> ::mechgen_runtime::Unit {
-                    Self::COORDINATE_UNITS
-                        .get(index)
-                        .copied()
-                        .unwrap_or(::mechgen_runtime::Unit::Angle)
-                }
-
-                fn equation_unit(&self, index: usize) -> ::mechgen_runtime::Unit {
-                    Self::EQUATION_UNITS
-                        .get(index)
-                        .copied()
-                        .unwrap_or(::mechgen_runtime::Unit::Angle)
-                }
-
+                #naming_methods
+                #parameter_methods
+                #unit_methods
                 #length_scale
 
                 #check_geometry
@@ -404,51 +296,169 @@ impl Context<'_> {
         }
     }
 
+    /// The `Outputs` variant of the scene's level and the marker traits it implements
+    /// (`Velocities`, `Accelerations`, `Forces`).
+    fn level_markers(&self) -> (TokenStream, TokenStream) {
+        let name = &self.model.name;
+        match self.model.outputs {
+            Outputs::Positions => (quote!(Positions), TokenStream::new()),
+            Outputs::Velocities => (
+                quote!(Velocities),
+                quote! { impl ::mechgen_runtime::Velocities for #name {} },
+            ),
+            Outputs::Accelerations => (
+                quote!(Accelerations),
+                quote! {
+                    impl ::mechgen_runtime::Velocities for #name {}
+                    impl ::mechgen_runtime::Accelerations for #name {}
+                },
+            ),
+            Outputs::Forces => (
+                quote!(Forces),
+                quote! {
+                    impl ::mechgen_runtime::Velocities for #name {}
+                    impl ::mechgen_runtime::Accelerations for #name {}
+                    impl ::mechgen_runtime::Forces for #name {}
+                },
+            ),
+        }
+    }
+
+    /// `Mechanism`'s naming methods: `dim`, `names`, and the coordinates' and equations' names,
+    /// read from the tables of [`Context::constants`].
+    fn naming_methods(&self) -> TokenStream {
+        let n_lit = idx(self.model.dim());
+        quote! {
+            fn dim(&self) -> Self::Dim {
+                ::mechgen_runtime::nalgebra::Const::<#n_lit>
+            }
+
+            fn names(&self) -> &'static ::mechgen_runtime::Names {
+                &Self::NAMES
+            }
+
+            fn coordinate_name(&self, index: usize) -> ::core::option::Option<&str> {
+                Self::COORDINATES.get(index).copied()
+            }
+
+            fn equation_name(&self, index: usize) -> ::core::option::Option<&str> {
+                Self::EQUATIONS.get(index).copied()
+            }
+        }
+    }
+
+    /// `Mechanism`'s parameter methods: count, names, reads by index and checked writes by
+    /// name.
+    fn parameter_methods(&self) -> TokenStream {
+        let model = self.model;
+        let param_count = idx(model.params.len());
+        let param_reads = model.params.iter().enumerate().map(|(i, p)| {
+            let (i, name) = (idx(i), &p.name);
+            quote! { #i => ::core::option::Option::Some(self.#name), }
+        });
+        let param_writes = model.params.iter().map(|p| {
+            let (name, key) = (&p.name, p.name.to_string());
+            quote! {
+            #key => {
+                self.#name = value;
+                ::core::result::Result::Ok(())
+            }
+            }
+        });
+        quote! {
+            fn parameter_count(&self) -> usize {
+                #param_count
+            }
+
+            fn parameter_name(&self, index: usize) -> ::core::option::Option<&str> {
+                Self::PARAMETERS.get(index).copied()
+            }
+
+            fn parameter(&self, index: usize) -> ::core::option::Option<f64> {
+                match index {
+                    #(#param_reads)*
+                    _ => ::core::option::Option::None,
+                }
+            }
+
+            fn set_parameter<'a>(
+                &'a mut self,
+                name: &'a str,
+                value: f64,
+            ) -> ::core::result::Result<(), ::mechgen_runtime::ParameterError<'a>> {
+                if !value.is_finite() && Self::PARAMETERS.contains(&name) {
+                    return ::core::result::Result::Err(
+                        ::mechgen_runtime::ParameterError::NonFinite { name, value },
+                    );
+                }
+                match name {
+                    #(#param_writes)*
+                    _ => ::core::result::Result::Err(
+                        ::mechgen_runtime::ParameterError::Unknown {
+                            name,
+                            declared: &Self::PARAMETERS,
+                        },
+                    ),
+                }
+            }
+        }
+    }
+
+    /// `Mechanism`'s units of coordinates and equations, read from the tables of
+    /// [`Context::constants`].
+    fn unit_methods(&self) -> TokenStream {
+        quote! {
+            fn coordinate_unit(&self, index: usize) -> ::mechgen_runtime::Unit {
+                Self::COORDINATE_UNITS
+                    .get(index)
+                    .copied()
+                    .unwrap_or(::mechgen_runtime::Unit::Angle)
+            }
+
+            fn equation_unit(&self, index: usize) -> ::mechgen_runtime::Unit {
+                Self::EQUATION_UNITS
+                    .get(index)
+                    .copied()
+                    .unwrap_or(::mechgen_runtime::Unit::Angle)
+            }
+        }
+    }
+
     /// The textbook functions over all coordinates: the initial guess, Φ, Φ_q, both in one
     /// pass, and ν and γ when the scene asked for them.
     fn textbook_functions(&self, kin: &Kinematics) -> TokenStream {
-        let model = self.model;
-        let n = model.dim();
-        let vector = self.vector_type();
-        let matrix = {
-            let n = idx(n);
-            quote!(::mechgen_runtime::Matrix<::mechgen_runtime::nalgebra::Const<#n>>)
-        };
-        let out_vector = [("out", quote!(&mut #vector))];
-        let q = [("q", quote!(&#vector))];
-        let vector_outputs = |values: &[Id], target: TokenStream| {
-            let clear = clear_if_sparse(&model.arena, values, &target);
-            (vector_outputs(values, &target), clear)
-        };
-        let jacobian_outputs = |target: TokenStream| {
-            let outputs: Vec<(TokenStream, Id)> = kin
-                .jacobian
-                .iter()
-                .map(|e| (matrix_target(&target, e.row, e.col), e.value))
-                .collect();
-            let clear = if kin.jacobian.len() < n * n {
-                quote! { #target.as_mut_slice().fill(0.0); }
-            } else {
-                TokenStream::new()
-            };
-            (outputs, clear)
-        };
         let guess = {
-            let (outputs, clear) = vector_outputs(&kin.guess, quote!(q));
+            let (outputs, clear) = self.vector_writes(&kin.guess, quote!(q));
             self.function(&outputs, clear, &computed()).body
         };
+        let constraints = self.constraint_functions(kin);
+        let rates = self.rate_functions(kin);
+        quote! {
+            fn initial_guess(&self, q: &mut ::mechgen_runtime::Vector<Self::Dim>) {
+                #guess
+            }
+            #constraints
+            #rates
+        }
+    }
+
+    /// `phi`, `jacobian` and `phi_and_jacobian`.
+    fn constraint_functions(&self, kin: &Kinematics) -> TokenStream {
+        let (vector, matrix) = (self.vector_type(), self.matrix_type());
+        let out_vector = [("out", quote!(&mut #vector))];
+        let q = [("q", quote!(&#vector))];
         let phi = {
-            let (outputs, clear) = vector_outputs(&kin.phi, quote!(out));
+            let (outputs, clear) = self.vector_writes(&kin.phi, quote!(out));
             self.bounded("phi", &outputs, clear, &out_vector, &q, &computed())
         };
         let jacobian = {
-            let (outputs, clear) = jacobian_outputs(quote!(out));
+            let (outputs, clear) = self.jacobian_writes(kin, quote!(out));
             let outs = [("out", quote!(&mut #matrix))];
             self.bounded("jacobian", &outputs, clear, &outs, &q, &computed())
         };
         let phi_and_jacobian = {
-            let (mut outputs, mut clear) = vector_outputs(&kin.phi, quote!(phi));
-            let (jac_outputs, jac_clear) = jacobian_outputs(quote!(jacobian));
+            let (mut outputs, mut clear) = self.vector_writes(&kin.phi, quote!(phi));
+            let (jac_outputs, jac_clear) = self.jacobian_writes(kin, quote!(jacobian));
             outputs.extend(jac_outputs);
             clear.extend(jac_clear);
             let outs = [
@@ -470,13 +480,25 @@ impl Context<'_> {
             quote!(phi_and_jacobian),
             quote!(phi: &mut #vector, jacobian: &mut #matrix),
         );
+        quote! {
+            #phi
+            #jacobian
+            #phi_and_jacobian
+        }
+    }
+
+    /// `nu` and `gamma`, each when the scene asked for it.
+    fn rate_functions(&self, kin: &Kinematics) -> TokenStream {
+        let vector = self.vector_type();
+        let out_vector = [("out", quote!(&mut #vector))];
+        let q = [("q", quote!(&#vector))];
         let nu = kin.nu.as_deref().map(|nu| {
-            let (outputs, clear) = vector_outputs(nu, quote!(out));
+            let (outputs, clear) = self.vector_writes(nu, quote!(out));
             let f = self.bounded("nu", &outputs, clear, &out_vector, &q, &computed());
             signature(&f, "ν = −Φ_t", quote!(nu), quote!(out: &mut #vector))
         });
         let gamma = kin.gamma.as_deref().map(|gamma| {
-            let (outputs, clear) = vector_outputs(gamma, quote!(out));
+            let (outputs, clear) = self.vector_writes(gamma, quote!(out));
             let q_qd = [("q", quote!(&#vector)), ("qd", quote!(&#vector))];
             let f = self.bounded("gamma", &outputs, clear, &out_vector, &q_qd, &computed());
             let qd = &f.args.qd;
@@ -489,15 +511,46 @@ impl Context<'_> {
             )
         });
         quote! {
-            fn initial_guess(&self, q: &mut ::mechgen_runtime::Vector<Self::Dim>) {
-                #guess
-            }
-            #phi
-            #jacobian
-            #phi_and_jacobian
             #nu
             #gamma
         }
+    }
+
+    /// `::mechgen_runtime::Matrix<Const<N>>` for this scene.
+    fn matrix_type(&self) -> TokenStream {
+        let n = idx(self.model.dim());
+        quote!(::mechgen_runtime::Matrix<::mechgen_runtime::nalgebra::Const<#n>>)
+    }
+
+    /// The writes of `values` into `target[i]`, and the clear they need (some are zero).
+    fn vector_writes(
+        &self,
+        values: &[Id],
+        target: TokenStream,
+    ) -> (Vec<(TokenStream, Id)>, TokenStream) {
+        let clear = clear_if_sparse(&self.model.arena, values, &target);
+        (vector_outputs(values, &target), clear)
+    }
+
+    /// The writes of Φ_q's structural non-zeros into `target[(r, c)]`, and the clear they need
+    /// (some entries are not structural).
+    fn jacobian_writes(
+        &self,
+        kin: &Kinematics,
+        target: TokenStream,
+    ) -> (Vec<(TokenStream, Id)>, TokenStream) {
+        let n = self.model.dim();
+        let outputs: Vec<(TokenStream, Id)> = kin
+            .jacobian
+            .iter()
+            .map(|e| (matrix_target(&target, e.row, e.col), e.value))
+            .collect();
+        let clear = if kin.jacobian.len() < n * n {
+            quote! { #target.as_mut_slice().fill(0.0); }
+        } else {
+            TokenStream::new()
+        };
+        (outputs, clear)
     }
 
     /// Named access to the bodies of a solved state: `state.piston().x`.
@@ -532,27 +585,8 @@ impl Context<'_> {
             quote! { #docs fn #ident(&self) -> ::mechgen_runtime::#view; }
         });
         let (marker_declarations, marker_implementations) = self.marker_accessors();
-        let implementations = model.bodies.iter().enumerate().map(|(i, b)| {
-            let ident = &b.name;
-            let [x, y, th] = [3 * i, 3 * i + 1, 3 * i + 2].map(idx);
-            let velocity = (model.outputs >= Outputs::Velocities).then(|| {
-                quote! { x_dot: self.qd()[#x], y_dot: self.qd()[#y], theta_dot: self.qd()[#th], }
-            });
-            let acceleration = (model.outputs >= Outputs::Accelerations).then(|| {
-                quote! {
-                    x_ddot: self.qdd()[#x], y_ddot: self.qdd()[#y], theta_ddot: self.qdd()[#th],
-                }
-            });
-            quote! {
-                fn #ident(&self) -> ::mechgen_runtime::#view {
-                    ::mechgen_runtime::#view {
-                        x: self.q[#x], y: self.q[#y], theta: self.q[#th],
-                        #velocity
-                        #acceleration
-                    }
-                }
-            }
-        });
+        let implementations =
+            (model.bodies.iter().enumerate()).map(|(i, b)| self.body_accessor(i, &b.name, &view));
         quote! {
             #[doc = #bodies_doc]
             #vis trait #bodies_trait {
@@ -566,6 +600,50 @@ impl Context<'_> {
             }
         }
     }
+
+    /// The accessor of body `i` on `State`: its pose and the rates the scene computes, as the
+    /// `view` type.
+    fn body_accessor(&self, i: usize, ident: &Ident, view: &TokenStream) -> TokenStream {
+        let outputs = self.model.outputs;
+        let [x, y, th] = [3 * i, 3 * i + 1, 3 * i + 2].map(idx);
+        let velocity = (outputs >= Outputs::Velocities).then(|| {
+            quote! { x_dot: self.qd()[#x], y_dot: self.qd()[#y], theta_dot: self.qd()[#th], }
+        });
+        let acceleration = (outputs >= Outputs::Accelerations).then(|| {
+            quote! {
+                x_ddot: self.qdd()[#x], y_ddot: self.qdd()[#y], theta_ddot: self.qdd()[#th],
+            }
+        });
+        quote! {
+            fn #ident(&self) -> ::mechgen_runtime::#view {
+                ::mechgen_runtime::#view {
+                    x: self.q[#x], y: self.q[#y], theta: self.q[#th],
+                    #velocity
+                    #acceleration
+                }
+            }
+        }
+    }
+}
+
+/// One `pub const NAME_X: usize` per coordinate: its index in q.
+fn coordinate_indices(coordinate_names: &[String]) -> TokenStream {
+    let consts = coordinate_names.iter().enumerate().map(|(i, c)| {
+        let ident = format_ident!("{}", c.replace('.', "_").to_uppercase());
+        let doc = format!(" Index of `{c}` in q.");
+        let i = idx(i);
+        quote! { #[doc = #doc] pub const #ident: usize = #i; }
+    });
+    quote!(#(#consts)*)
+}
+
+/// `[::mechgen_runtime::Unit::Length, …]`: a units table.
+fn unit_list(units: Vec<Unit>) -> TokenStream {
+    let units = units.into_iter().map(|u| {
+        let variant = format_ident!("{}", u.name());
+        quote!(::mechgen_runtime::Unit::#variant)
+    });
+    quote!([#(#units),*])
 }
 
 /// A textbook function's item: doc, signature (`q`, `q̇` if the function takes it, `t`, then
