@@ -96,7 +96,7 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
         })
         .map(|c| c.kind.equation_suffixes().len())
         .sum();
-    let env = mechgen::interpret::Env {
+    let env = mechgen::expr::tape::Env {
         params: model.params.iter().map(|p| p.default).collect(),
         ..Default::default()
     };
@@ -104,7 +104,7 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
     let dependent: Vec<f64> = scale
         .dependent
         .iter()
-        .map(|&id| mechgen::interpret::eval(&model.arena, id, &env))
+        .map(|&id| mechgen::expr::tape::eval(&model.arena, id, &env))
         .collect();
     Summary {
         mechanism: model.name.to_string(),
@@ -133,7 +133,7 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
             .iter()
             .map(|d| Parameter {
                 name: d.name.to_string(),
-                default: mechgen::interpret::eval(&model.arena, d.value, &env) + 0.0,
+                default: mechgen::expr::tape::eval(&model.arena, d.value, &env) + 0.0,
             })
             .collect(),
         branches: model
@@ -154,7 +154,7 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
             // `+ 0.0`: no `-0` in the report (a gravity `(0, -9810)` folds its x to −0).
             gravity: model
                 .gravity
-                .map(|g| mechgen::interpret::eval(&model.arena, g, &env) + 0.0),
+                .map(|g| mechgen::expr::tape::eval(&model.arena, g, &env) + 0.0),
             loads: model.loads.iter().map(|l| l.name.clone()).collect(),
             reactions: model.reaction_names(),
         }),
@@ -305,14 +305,14 @@ fn numbered(out: &mut String, names: &[String]) -> fmt::Result {
 
 fn write_stats(out: &mut String, scene: &Scene) -> fmt::Result {
     writeln!(out, "\nsolve structure:")?;
-    for line in mechgen::stats::structure(scene).lines() {
+    for line in mechgen::plan::stats::structure(scene).lines() {
         writeln!(out, "  {line}")?;
     }
     writeln!(
         out,
         "\noperation counts per generated function (each shared sub-expression once):"
     )?;
-    for line in mechgen::stats::table(scene).lines() {
+    for line in mechgen::plan::stats::table(scene).lines() {
         writeln!(out, "  {line}")?;
     }
     Ok(())
@@ -359,7 +359,7 @@ mod tests {
             "{text}"
         );
 
-        let counts = mechgen::stats::function_counts(&scene);
+        let counts = mechgen::plan::stats::function_counts(&scene);
         let names: Vec<_> = counts.iter().map(|f| f.function).collect();
         assert_eq!(
             names,

@@ -18,7 +18,7 @@ pub use args::Command;
 pub use mechgen_interp::Interpreted;
 
 use args::{Input, Output, SolveArgs, Times};
-use mechgen::limits::Limits;
+use mechgen::syntax::limits::Limits;
 use mechgen_runtime::sample_time;
 
 /// Exit status for a bad command line.
@@ -169,7 +169,7 @@ fn too_large(name: &str, size: &str, limits: &Limits) -> Failure {
          takes about 2 s and 70 MB per 100 000 statements); scenes this \
          large are better built in code with `mechgen::builder`",
         limits.bytes,
-        mechgen::limits::MAX_SOURCE_BYTES
+        mechgen::syntax::limits::MAX_SOURCE_BYTES
     ))
 }
 
@@ -188,7 +188,7 @@ fn read_failure(name: &str, error: &io::Error) -> Failure {
 
 /// Reads the scene's text within `limits` (statement by statement) and compiles it.
 fn compile(source: &Source, limits: &Limits) -> Result<mechgen::Scene, Failure> {
-    let read = mechgen::source::read(&source.text, limits);
+    let read = mechgen::syntax::source::read(&source.text, limits);
     read.spec
         .map_err(mechgen::Errors::from)
         .and_then(|spec| mechgen::compile_spec(&spec))

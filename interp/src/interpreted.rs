@@ -10,12 +10,12 @@
 use std::cell::{Cell, RefCell};
 
 use mechgen::Scene;
-use mechgen::factor::Factorization;
-use mechgen::interpret::{Inputs, Tape};
-use mechgen::kinematics::LengthScale;
-use mechgen::reactions::ForceStage;
-use mechgen::structure::{self, Phase, Plan};
-use mechgen::{geometry, physics};
+use mechgen::expr::tape::{Inputs, Tape};
+use mechgen::model::kinematics::LengthScale;
+use mechgen::model::{geometry, physics};
+use mechgen::plan::reactions::ForceStage;
+use mechgen::plan::structure::{self, Phase, Plan};
+use mechgen::sparse::factor::Factorization;
 use mechgen_runtime::first_load_fault;
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{

@@ -2,7 +2,7 @@
 //! identical linkages), typically from a `build.rs` that writes the generated code into
 //! `OUT_DIR` for the crate to `include!`.
 //!
-//! [`SceneBuilder`] produces the spec *text* of [`crate::parse`]'s grammar, so a built scene goes
+//! [`SceneBuilder`] produces the spec *text* of [`crate::syntax::parse`]'s grammar, so a built scene goes
 //! through exactly the pipeline a hand-written one does and every check applies (unknown bodies,
 //! duplicate names, the Gruebler degree-of-freedom count, …). Names, numbers and expressions are
 //! checked early, as each statement is added; those errors and the checker's are returned
@@ -44,7 +44,7 @@ use proc_macro2::{Delimiter, Spacing, Span, TokenStream, TokenTree};
 use crate::emit::CodegenOptions;
 use crate::error::Errors;
 use crate::model::Outputs;
-pub use crate::spec::{Product, Sign};
+pub use crate::syntax::spec::{Product, Sign};
 
 /// A scalar of the spec: a number, or an expression in parameters (and `t` in drivers) written
 /// in the grammar's syntax, e.g. `"omega * t"` or `"0.5 * sin(2 * t)"`.
@@ -410,7 +410,7 @@ impl SceneBuilder {
 
     /// `branch NAME: cross(u.0 -> u.1, v.0 -> v.1) > 0;` (or `dot(…)`, or `< 0`): a branch
     /// invariant, the product of two world vectors between body-fixed points whose sign the
-    /// solver keeps (see [`crate::parse`]).
+    /// solver keeps (see [`crate::syntax::parse`]).
     ///
     /// ```
     /// # use mechgen::builder::{Product, SceneBuilder, Sign};
@@ -445,7 +445,7 @@ impl SceneBuilder {
         ))
     }
 
-    /// The scene as spec text (the grammar of [`crate::parse`]), ready for
+    /// The scene as spec text (the grammar of [`crate::syntax::parse`]), ready for
     /// [`crate::compile_str`] or a `.mech` file.
     ///
     /// # Errors
@@ -695,8 +695,8 @@ fn expression(source: &str) -> Result<String, String> {
         return Err("empty; write a number or an expression".to_owned());
     }
     // The size limits first: the expression parser recurses on nesting.
-    crate::limits::check(&tokens).map_err(|e| e.to_string())?;
-    syn::parse2::<crate::spec::Expr>(tokens.clone()).map_err(|e| e.to_string())?;
+    crate::syntax::limits::check(&tokens).map_err(|e| e.to_string())?;
+    syn::parse2::<crate::syntax::spec::Expr>(tokens.clone()).map_err(|e| e.to_string())?;
     Ok(tokens.to_string())
 }
 
@@ -974,12 +974,12 @@ mod tests {
         let model = &compiled.model;
         assert_eq!(model.params.len(), 2);
         assert_eq!(model.derived.len(), 1);
-        let env = crate::interpret::Env {
+        let env = crate::expr::tape::Env {
             params: vec![3.0, 4.0],
             ..Default::default()
         };
         assert_eq!(
-            crate::interpret::eval(&model.arena, model.derived[0].value, &env),
+            crate::expr::tape::eval(&model.arena, model.derived[0].value, &env),
             5.0
         );
     }

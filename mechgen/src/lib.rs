@@ -16,54 +16,24 @@
 
 pub mod builder;
 pub mod check;
-pub mod diff;
-pub mod dynamics;
 pub mod emit;
 pub mod error;
 pub mod expr;
-pub mod factor;
-mod frames;
-pub mod geometry;
-pub mod graph;
-pub mod interpret;
-pub mod kinematics;
-pub mod limits;
-pub mod markers;
 pub mod model;
-pub mod parse;
-pub mod physics;
-pub mod reactions;
-pub mod resolution;
-pub mod source;
-pub mod spec;
-pub mod spline;
-pub mod stats;
-pub mod structure;
+pub mod plan;
+pub mod sparse;
+pub mod syntax;
 
 use proc_macro2::TokenStream;
 
 pub use emit::CodegenOptions;
 pub use error::Errors;
-pub use kinematics::Kinematics;
 pub use model::Model;
-
-/// A checked model with its derived kinematics and solve structure: everything needed to emit
-/// or interpret a scene.
-#[derive(Clone)]
-pub struct Scene {
-    /// The checked model; its arena also holds the derived expressions.
-    pub model: Model,
-    /// Φ, Φ_q, ν, γ and the initial guess.
-    pub kinematics: Kinematics,
-    /// The stages of the solve: explicit assignments and Newton blocks with their static LU.
-    pub plan: structure::Plan,
-    /// The force solve, for a scene that computes forces: the generalised forces, the plan's
-    /// stages in reverse, the reported reactions.
-    pub forces: Option<reactions::Forces>,
-    /// For a scene that computes forces, two values per load that name the load making F
-    /// non-finite (`dynamics::load_witnesses`); empty otherwise.
-    pub load_witnesses: Vec<expr::Id>,
-}
+pub use model::kinematics::Kinematics;
+use model::{dynamics, kinematics};
+pub use plan::Scene;
+use plan::{reactions, structure};
+use syntax::{limits, parse, source, spec};
 
 /// Parses, checks and differentiates a spec given as tokens.
 ///

@@ -83,9 +83,9 @@ fn operation_table(source: &str) -> Result<String, mechgen::Errors> {
         naive.kinematics.jacobian.len()
     );
     table += "lean (folded, simplified, shared sub-expressions):\n";
-    table += &mechgen::stats::table(&lean);
+    table += &mechgen::plan::stats::table(&lean);
     table += "\nnaive (no folding or simplification, every use evaluated):\n";
-    table += &mechgen::stats::table(&naive);
+    table += &mechgen::plan::stats::table(&naive);
     Ok(table)
 }
 
@@ -95,7 +95,7 @@ fn solve_structure() {
         let source = fs::read_to_string(&path).expect("readable scene");
         let scene = mechgen::compile_str(&source)
             .unwrap_or_else(|e| panic!("{} does not compile:\n{e}", path.display()));
-        let structure = mechgen::stats::structure(&scene);
+        let structure = mechgen::plan::stats::structure(&scene);
         with_scene_settings(&path, || {
             insta::assert_snapshot!(format!("{}_structure", stem(&path)), structure);
         });

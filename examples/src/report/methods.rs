@@ -19,8 +19,8 @@
 use std::cell::RefCell;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
+use mechgen::expr::tape::{Inputs, Scalar, Tape};
 use mechgen::expr::{Func, Func2};
-use mechgen::interpret::{Inputs, Scalar, Tape};
 use mechgen_runtime::nalgebra::{DefaultAllocator, Dim, U1};
 use mechgen_runtime::{
     Accelerations, Matrix, Mechanism, Outputs, ParameterError, Storage, Unit, Vector, Velocities,

@@ -10,7 +10,7 @@ use syn::Ident;
 use super::Checker;
 use crate::expr::Id;
 use crate::model::{Load, LoadKind, MassProperties, Outputs, Point};
-use crate::spec::{BodyDecl, Expr, LoadDecl, PointRef, Spec};
+use crate::syntax::spec::{BodyDecl, Expr, LoadDecl, PointRef, Spec};
 
 /// Names of the accessors generated for a scene that computes forces (`state.reactions()`,
 /// `state.efforts()`), which a body's accessor of the same name would make ambiguous.
@@ -71,7 +71,7 @@ impl Checker {
     /// A load: forces and torques on moving bodies, springs between two bodies not both fixed.
     pub(super) fn load(&mut self, decl: &LoadDecl) -> Option<Load> {
         let kind = match &decl.kind {
-            crate::spec::LoadKind::Force {
+            crate::syntax::spec::LoadKind::Force {
                 point,
                 value,
                 local,
@@ -84,12 +84,12 @@ impl Checker {
                     local: *local,
                 }
             }
-            crate::spec::LoadKind::Torque { body, value } => {
+            crate::syntax::spec::LoadKind::Torque { body, value } => {
                 let value = self.lower(value, true);
                 let body = self.loaded_body(body)?;
                 LoadKind::Torque { body, value }
             }
-            crate::spec::LoadKind::Spring {
+            crate::syntax::spec::LoadKind::Spring {
                 a,
                 b,
                 stiffness,
@@ -254,7 +254,7 @@ impl Checker {
 #[cfg(test)]
 mod tests {
     use crate::model::{LoadKind, Outputs};
-    use crate::source::parse_str;
+    use crate::syntax::source::parse_str;
 
     const ARM: &str = "
         ground frame at (0, 0, 0);

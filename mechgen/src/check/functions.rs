@@ -12,10 +12,10 @@ use proc_macro2::Span;
 use syn::Ident;
 
 use super::Checker;
+use super::resolution::{MIN_LENGTH, RESOLUTION};
+use crate::expr::spline::SplineTable;
 use crate::expr::{Func, Func2, Id};
-use crate::resolution::{MIN_LENGTH, RESOLUTION};
-use crate::spec::{Expr, ExprKind};
-use crate::spline::SplineTable;
+use crate::syntax::spec::{Expr, ExprKind};
 
 /// Every function name, with how it is called, for error messages.
 const FUNCTIONS: [&str; 16] = [

@@ -8,7 +8,7 @@ use syn::Ident;
 use super::Checker;
 use crate::expr::{Func, Id};
 use crate::model::{ConstraintKind, Driven, Marker, MarkerKind, Point};
-use crate::spec::{DriverKind, Expr, JointKind, MarkerDecl, PointRef};
+use crate::syntax::spec::{DriverKind, Expr, JointKind, MarkerDecl, PointRef};
 
 impl Checker {
     /// A joint of the spec as a constraint of the model.
@@ -208,8 +208,8 @@ impl Checker {
     /// A marker: a point on a known body, or the angle between two different bodies.
     pub(super) fn marker(&mut self, decl: &MarkerDecl) -> Option<Marker> {
         let kind = match &decl.kind {
-            crate::spec::MarkerKind::Point(p) => MarkerKind::Point(self.point(p)?),
-            crate::spec::MarkerKind::Angle(a, b) => {
+            crate::syntax::spec::MarkerKind::Point(p) => MarkerKind::Point(self.point(p)?),
+            crate::syntax::spec::MarkerKind::Angle(a, b) => {
                 let (ia, ib) = (self.body(a), self.body(b));
                 let (ia, ib) = (ia?, ib?);
                 if ia == ib {

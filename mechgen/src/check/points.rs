@@ -9,7 +9,7 @@ use std::collections::HashMap;
 use proc_macro2::Ident;
 
 use crate::error::Errors;
-use crate::spec::{DriverKind, JointKind, LoadKind, MarkerKind, PointRef, Spec};
+use crate::syntax::spec::{DriverKind, JointKind, LoadKind, MarkerKind, PointRef, Spec};
 
 /// `spec` with every use of a named point replaced by the point; `None` when it declares none.
 /// Reports a point declared on an unknown body or on another named point, and a use with an

@@ -14,8 +14,8 @@ use super::plan::Kernels;
 use super::{idx, signature_with};
 use crate::expr::Id;
 use crate::model::ConstraintKind;
-use crate::reactions::{ForceStage, Forces};
-use crate::structure::{Phase, Stage};
+use crate::plan::reactions::{ForceStage, Forces};
+use crate::plan::structure::{Phase, Stage};
 
 impl Context<'_> {
     /// `generalized_forces`, `reactions` and `reaction_name` for `impl Mechanism`.

@@ -9,7 +9,7 @@ use quote::{format_ident, quote};
 use super::body::{Context, computed};
 use super::idx;
 use crate::model::{MarkerKind, Outputs};
-use crate::structure::{Phase, Plan};
+use crate::plan::structure::{Phase, Plan};
 
 impl Context<'_> {
     /// Number of marker values.

@@ -20,10 +20,10 @@ use quote::{format_ident, quote};
 pub use body::f64_literal;
 use body::{Context, Function, computed};
 
-use crate::Scene;
 use crate::expr::{Arena, Id};
-use crate::kinematics::Kinematics;
+use crate::model::kinematics::Kinematics;
 use crate::model::{Outputs, Unit};
+use crate::plan::Scene;
 
 /// Choices that shape the generated code without changing its meaning.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -630,7 +630,7 @@ fn clear_if_sparse(arena: &Arena, values: &[Id], target: &TokenStream) -> TokenS
 impl Context<'_> {
     /// `length_scale`: the constant lengths folded into one literal, the parameter-dependent
     /// ones evaluated and folded in with `max(|v|)`, in the order of
-    /// [`LengthScale::evaluate`](crate::kinematics::LengthScale::evaluate).
+    /// [`LengthScale::evaluate`](crate::model::kinematics::LengthScale::evaluate).
     fn length_scale(&self, kin: &Kinematics) -> TokenStream {
         let scale = &kin.length_scale;
         let constant = f64_literal(scale.constant);
@@ -694,7 +694,7 @@ impl Context<'_> {
 
     /// `check_geometry` for a scene with geometry written in parameters (the runtime's default,
     /// nothing to check, otherwise): each value evaluated with the current parameters and
-    /// checked against its rule, in declaration order ([`crate::geometry`]).
+    /// checked against its rule, in declaration order ([`crate::model::geometry`]).
     fn check_geometry(&self, kin: &Kinematics) -> TokenStream {
         let checks = &kin.geometry;
         if checks.is_empty() {

@@ -1,13 +1,13 @@
 //! `check_physics` for a scene whose mass properties or load constants are written in
-//! parameters ([`crate::physics`]); nothing for any other scene.
+//! parameters ([`crate::model::physics`]); nothing for any other scene.
 
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
 use super::body::Context;
 use super::idx;
-use crate::kinematics::Kinematics;
-use crate::physics::Subject;
+use crate::model::kinematics::Kinematics;
+use crate::model::physics::Subject;
 
 impl Context<'_> {
     /// `check_physics`: each value evaluated with the current parameters and checked against

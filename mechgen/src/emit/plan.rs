@@ -13,9 +13,9 @@ use quote::{format_ident, quote};
 use super::body::{Context, Function};
 use super::idx;
 use crate::expr::Id;
-use crate::factor::Factorization;
 use crate::model::Model;
-use crate::structure::{Assignment, Block, Phase, Plan, Stage, TrigCache};
+use crate::plan::structure::{Assignment, Block, Phase, Plan, Stage, TrigCache};
+use crate::sparse::factor::Factorization;
 
 /// `impl Structured` and the inherent items it dispatches to.
 pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {

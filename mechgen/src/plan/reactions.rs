@@ -28,11 +28,11 @@
 
 use std::collections::HashMap;
 
-use crate::diff::Differentiator;
+use crate::expr::diff::Differentiator;
 use crate::expr::{Arena, Id, Var, var_index};
-use crate::kinematics::Kinematics;
+use crate::model::kinematics::Kinematics;
 use crate::model::{ConstraintKind, Model};
-use crate::structure::{Plan, Stage};
+use crate::plan::structure::{Plan, Stage};
 
 /// A scene's force solve: the generalised forces, the reverse stages and the reported
 /// reactions (ids into the model's arena).
@@ -353,7 +353,7 @@ fn reported(model: &mut Model, kin: &Kinematics) -> Vec<Id> {
 /// through the frame's coordinates, `−Σ_i ∂Φ_i/∂q_k λ_i` at the frame's pose, plus the pull of
 /// the springs anchored to it.
 fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
-    let mut loads = crate::dynamics::ground_spring_loads(model);
+    let mut loads = crate::model::dynamics::ground_spring_loads(model);
     debug_assert_eq!(loads.len(), n);
     let ground: Vec<(usize, [Id; 3])> = model
         .bodies
@@ -365,7 +365,7 @@ fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
     if ground.is_empty() {
         return loads;
     }
-    let textbook = crate::kinematics::textbook_equations(model);
+    let textbook = crate::model::kinematics::textbook_equations(model);
     // Ground equations touch only their own body, and their multipliers are not loads.
     let ground_rows: Vec<bool> = model
         .constraints
@@ -406,7 +406,7 @@ fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
 mod tests {
     use super::{ForceStage, assert_reads_later_stages, resolution_order};
     use crate::expr::{Var, var_index};
-    use crate::structure::Stage;
+    use crate::plan::structure::Stage;
 
     /// Issue 20's first scene: its fixed stage holds the prismatic joint's two equations.
     const PRISMATIC_TORQUE: &str = "mechanism PrismaticTorque {

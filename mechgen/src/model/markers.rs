@@ -4,9 +4,9 @@
 //! symbols, the second reading q̈), taken only as far as the scene's outputs go, so a
 //! positions-only scene gets positions only.
 
-use crate::diff::Differentiator;
 use crate::expr::Id;
-use crate::frames::{Frames, ground_poses};
+use crate::expr::diff::Differentiator;
+use crate::model::frames::{Frames, ground_poses};
 use crate::model::{MarkerKind, Model, Outputs};
 
 /// Every marker's values in layout order ([`Model::marker_names`]): its positions, then their
@@ -48,7 +48,7 @@ pub fn values(model: &mut Model) -> Vec<Id> {
 
 #[cfg(test)]
 mod tests {
-    use crate::interpret::{Env, eval};
+    use crate::expr::tape::{Env, eval};
 
     #[test]
     fn a_point_and_an_angle_with_their_rates() {

@@ -1,4 +1,4 @@
-//! The run-time counterpart of [`crate::resolution`]: the scene's geometry written in parameters
+//! The run-time counterpart of [`crate::check::resolution`]: the scene's geometry written in parameters
 //! (body-fixed points, distances, ground poses, prismatic axes, gear and rack ratios), each value
 //! with the rule it must satisfy, the joint it belongs to and a parameter it is computed from.
 //!
@@ -27,7 +27,7 @@ pub enum Requirement {
     Axis,
     /// A gear's or rack's ratio: finite and not zero.
     Ratio,
-    /// A body's mass: finite, at least zero ([`crate::physics`]).
+    /// A body's mass: finite, at least zero ([`crate::model::physics`]).
     Mass,
     /// A body's moment of inertia: finite, at least zero.
     Inertia,

@@ -3,13 +3,13 @@
 //! The grammar (the reference below is `docs/grammar.md`, also on the `mechanism!` macro and
 //! the runtime's front page). Only syntax is checked here; `check` does the rest.
 //!
-#![doc = include_str!("../../docs/grammar.md")]
+#![doc = include_str!("../../../docs/grammar.md")]
 
 use proc_macro2::TokenStream;
 use syn::parse::{Parse, ParseStream};
 use syn::{Attribute, Ident, LitFloat, LitInt, Token, Visibility, braced, parenthesized};
 
-use crate::spec::{
+use crate::syntax::spec::{
     BinOp, BodyDecl, BranchDecl, DriverDecl, DriverKind, Expr, ExprKind, GravityDecl, JointDecl,
     JointKind, LoadDecl, LoadKind, MarkerDecl, MarkerKind, MassDecl, ParamDecl, PointDecl,
     PointRef, Product, Sign, Spec,
@@ -45,7 +45,7 @@ mod kw {
 /// # Errors
 /// Input beyond the size limits (`limits`), or the first syntax error, at its tokens.
 pub fn parse_tokens(tokens: TokenStream) -> syn::Result<Spec> {
-    crate::limits::check(&tokens)?;
+    crate::syntax::limits::check(&tokens)?;
     syn::parse2(tokens)
 }
 
@@ -953,7 +953,7 @@ fn number(digits: &str, suffix: &str, span: proc_macro2::Span) -> syn::Result<Ex
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::source::parse_str;
+    use crate::syntax::source::parse_str;
 
     fn show(e: &Expr) -> String {
         match &e.kind {

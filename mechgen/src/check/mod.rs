@@ -11,6 +11,7 @@ mod functions;
 mod library;
 mod points;
 mod redundancy;
+pub mod resolution;
 
 pub use constant::constant_value;
 
@@ -21,12 +22,12 @@ use syn::Ident;
 
 use crate::error::Errors;
 use crate::expr::{Arena, Id, Node, Var};
-use crate::graph::{self, UNMATCHED};
 use crate::model::{
     Body, Branch, Constraint, ConstraintKind, Derived, Model, Outputs, Param, Point,
 };
-use crate::resolution::{self, Lengths};
-use crate::spec::{BinOp, BranchDecl, Expr, ExprKind, PointRef, Spec};
+use crate::sparse::graph::{self, UNMATCHED};
+use crate::syntax::spec::{BinOp, BranchDecl, Expr, ExprKind, PointRef, Spec};
+use resolution::Lengths;
 
 /// Checks a spec and builds its model.
 ///
@@ -414,7 +415,7 @@ impl Checker {
             let arena = &self.arena;
             arena.as_const(id).or_else(|| {
                 (!arena.any_node(id, |n| matches!(n, Node::Var(_) | Node::Param(_))))
-                    .then(|| crate::interpret::eval(arena, id, &crate::interpret::Env::default()))
+                    .then(|| crate::expr::tape::eval(arena, id, &crate::expr::tape::Env::default()))
             })
         };
         a.body == b.body
@@ -669,7 +670,8 @@ impl Checker {
             let constant = !self
                 .arena
                 .any_node(id, |n| matches!(n, Node::Var(_) | Node::Param(_)));
-            let value = crate::interpret::eval(&self.arena, id, &crate::interpret::Env::default());
+            let value =
+                crate::expr::tape::eval(&self.arena, id, &crate::expr::tape::Env::default());
             (constant && value.is_finite()).then_some(value)
         });
         match value {
@@ -916,7 +918,7 @@ impl Structure {
 
     /// The coordinates each of a model's equations touches, in Φ order.
     pub fn rows_of(model: &mut Model) -> Vec<Vec<usize>> {
-        let phi = crate::kinematics::constraint_equations(model);
+        let phi = crate::model::kinematics::constraint_equations(model);
         phi.iter()
             .map(|&e| {
                 model
@@ -1144,7 +1146,7 @@ fn edit_distance(a: &str, b: &str) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::source::parse_str;
+    use crate::syntax::source::parse_str;
 
     fn errors(source: &str) -> Vec<String> {
         let spec = parse_str(source).unwrap_or_else(|e| panic!("syntax: {e}"));
@@ -1302,12 +1304,12 @@ mod tests {
             ConstraintKind::Prismatic { axis, .. } => Some(axis),
             _ => None,
         });
-        let env = crate::interpret::Env {
+        let env = crate::expr::tape::Env {
             params: vec![w],
             ..Default::default()
         };
         axis.expect("a prismatic joint")
-            .map(|id| crate::interpret::eval(&model.arena, id, &env))
+            .map(|id| crate::expr::tape::eval(&model.arena, id, &env))
     }
 
     #[test]

@@ -11,8 +11,8 @@
 use proc_macro2::{Span, TokenStream};
 use syn::parse::{ParseStream, Parser};
 
-use crate::limits::{Limits, MAX_DEPTH, MAX_STATEMENT_TOKENS};
-use crate::spec::Spec;
+use crate::syntax::limits::{Limits, MAX_DEPTH, MAX_STATEMENT_TOKENS};
+use crate::syntax::spec::Spec;
 
 /// Text lexed at once: large enough that a file has few chunks (a span's chunk is found by a
 /// linear search), small enough that its tokens are a few megabytes.
@@ -95,7 +95,7 @@ fn read_into(source: &str, limits: &Limits, locations: &mut Locations) -> syn::R
             format!(
                 "the scene is {} bytes, more than the {} bytes mechgen reads (the limit is \
                  reached here); raise the limit to read it (`--max-file-size` on the command \
-                 line, `mechgen::limits::Limits` in code)",
+                 line, `mechgen::syntax::limits::Limits` in code)",
                 source.len(),
                 limits.bytes
             ),
@@ -111,7 +111,7 @@ fn read_into(source: &str, limits: &Limits, locations: &mut Locations) -> syn::R
         Origin { line: 1, column: 0 },
         locations,
         |input| {
-            let header = crate::parse::header(input)?;
+            let header = crate::syntax::parse::header(input)?;
             if !input.is_empty() {
                 return Err(input.error("expected `{`: the mechanism's body, `{ … }`"));
             }
@@ -150,7 +150,7 @@ fn read_into(source: &str, limits: &Limits, locations: &mut Locations) -> syn::R
             let content;
             syn::braced!(content in input);
             while !content.is_empty() {
-                crate::parse::statement(&content, &mut spec)?;
+                crate::syntax::parse::statement(&content, &mut spec)?;
             }
             Ok(())
         })?;
@@ -179,7 +179,7 @@ fn lex_and_parse<T>(
         locations.chunks.push((first.span(), origin));
     }
     // The scan enforced these already; the token check is exact and cheap.
-    crate::limits::check(&tokens)?;
+    crate::syntax::limits::check(&tokens)?;
     parser.parse2(tokens)
 }
 
@@ -335,7 +335,7 @@ impl Problem {
                 format!(
                     "the scene has {statements} statements, more than the {} mechgen reads \
                      (this is the first beyond the limit); raise the limit to read it \
-                     (`--max-statements` on the command line, `mechgen::limits::Limits` in \
+                     (`--max-statements` on the command line, `mechgen::syntax::limits::Limits` in \
                      code)",
                     limits.statements
                 ),

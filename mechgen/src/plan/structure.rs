@@ -23,13 +23,13 @@
 
 use std::collections::HashMap;
 
-use crate::diff::Differentiator;
+use crate::expr::diff::Differentiator;
+use crate::expr::tape::{Inputs, Tape};
 use crate::expr::{Arena, Func, Id, Node, Var, var_index};
-use crate::factor::{self, Factorization};
-use crate::graph;
-use crate::interpret::{Inputs, Tape};
-use crate::kinematics::Kinematics;
+use crate::model::kinematics::Kinematics;
 use crate::model::{Model, Outputs};
+use crate::sparse::factor::{self, Factorization};
+use crate::sparse::graph;
 
 /// Static factorisations with more updates than this are not emitted as straight-line code
 /// (rustc's time grows quickly with a function's size); such a block is factored with partial
@@ -107,7 +107,7 @@ impl TrigCache {
             Phase::After => self.filled_by[m] <= stage,
             Phase::Final => true,
         };
-        crate::interpret::topological_order(arena, roots)
+        crate::expr::tape::topological_order(arena, roots)
             .into_iter()
             .filter_map(|id| {
                 let &i = self.slot.get(&id)?;
@@ -322,7 +322,7 @@ fn trig_cache(arena: &mut Arena, stages: &[Stage], n: usize, final_roots: &[Id])
         .flat_map(|(s, stage)| kernel_roots(stage).map(|k| (s, k)))
         .chain([final_kernels]);
     for (s, (phase, roots)) in kernels {
-        for id in crate::interpret::topological_order(arena, &roots) {
+        for id in crate::expr::tape::topological_order(arena, &roots) {
             if let Node::Call(Func::Sin | Func::Cos, a) = arena.node(id)
                 && let Node::Var(Var::Q(k)) = arena.node(a)
             {

@@ -11,7 +11,7 @@
 
 use std::collections::HashSet;
 
-use crate::geometry::{Requirement, first_parameter};
+use crate::model::geometry::{Requirement, first_parameter};
 use crate::model::{LoadKind, Model};
 
 /// What a checked value belongs to (mirrors `mechgen_runtime::Subject`).

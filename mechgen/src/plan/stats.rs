@@ -4,9 +4,9 @@
 
 use std::fmt;
 
-use crate::Scene;
+use crate::expr::tape::topological_order;
 use crate::expr::{Arena, Func, Id, Node};
-use crate::interpret::topological_order;
+use crate::plan::Scene;
 
 /// How many operations of each kind a straight-line evaluation performs (each DAG node once).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -203,12 +203,12 @@ pub fn table(scene: &Scene) -> String {
 /// LU's entries, fill-in and updates, and what it solves); scenes with many stages show the
 /// first and last ones and a histogram of block sizes.
 pub fn structure(scene: &Scene) -> String {
-    use crate::structure::Stage;
+    use crate::plan::structure::Stage;
     const SHOWN: usize = 24;
     let (model, plan) = (&scene.model, &scene.plan);
     let arena = &model.arena;
     let (coordinates, equations) = (model.coordinate_names(), model.equation_names());
-    let fixed = |assignments: &[crate::structure::Assignment]| {
+    let fixed = |assignments: &[crate::plan::structure::Assignment]| {
         assignments.iter().all(|a| arena.is_invariant(a.position))
     };
     let explicit: usize = plan.assignments().count();
@@ -220,7 +220,7 @@ pub fn structure(scene: &Scene) -> String {
             _ => None,
         })
         .sum();
-    let blocks: Vec<&crate::structure::Block> = plan.blocks().collect();
+    let blocks: Vec<&crate::plan::structure::Block> = plan.blocks().collect();
     let in_blocks: usize = blocks.iter().map(|b| b.equations.len()).sum();
     let (entries, fill, updates) =
         blocks
