@@ -168,7 +168,9 @@ mod tests {
         let read =
             mechgen::syntax::source::read(source, &mechgen::syntax::limits::Limits::default());
         let errors = match read.spec {
-            Ok(spec) => mechgen::compile_spec(&spec).err().expect("errors"),
+            Ok(spec) => mechgen::compile(mechgen::Input::Spec(&spec), &mechgen::Options::default())
+                .err()
+                .expect("errors"),
             Err(error) => error.into(),
         };
         render("scene.mech", source, &read.locations, &errors)

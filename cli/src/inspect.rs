@@ -333,7 +333,8 @@ mod tests {
 
     #[test]
     fn reports_structure_and_counts() {
-        let scene = mechgen::compile_str(SCENE).expect("compiles");
+        let scene = mechgen::compile(mechgen::Input::Text(SCENE), &mechgen::Options::default())
+            .expect("compiles");
         let text = report(&scene, "p.mech", true);
         assert!(text.contains("coordinates (6):\n  0  frame.x\n"), "{text}");
         assert!(text.contains("equations (6):"), "{text}");
@@ -374,7 +375,8 @@ mod tests {
 
     #[test]
     fn json_holds_the_same_facts() {
-        let scene = mechgen::compile_str(SCENE).expect("compiles");
+        let scene = mechgen::compile(mechgen::Input::Text(SCENE), &mechgen::Options::default())
+            .expect("compiles");
         let value: serde_json::Value = serde_json::from_str(&json(&scene, "p.mech")).unwrap();
         assert_eq!(value["mechanism"], "Pendulum");
         assert_eq!(value["coordinates"][0], "frame.x");

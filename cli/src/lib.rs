@@ -191,7 +191,9 @@ fn compile(source: &Source, limits: &Limits) -> Result<mechgen::Scene, Failure> 
     let read = mechgen::syntax::source::read(&source.text, limits);
     read.spec
         .map_err(mechgen::Errors::from)
-        .and_then(|spec| mechgen::compile_spec(&spec))
+        .and_then(|spec| {
+            mechgen::compile(mechgen::Input::Spec(&spec), &mechgen::Options::default())
+        })
         .map_err(|errors| {
             Failure::Failed(diagnostics::render(
                 &source.name,

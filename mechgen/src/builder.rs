@@ -446,7 +446,7 @@ impl SceneBuilder {
     }
 
     /// The scene as spec text (the grammar of [`crate::syntax::parse`]), ready for
-    /// [`crate::compile_str`] or a `.mech` file.
+    /// [`crate::compile`] or a `.mech` file.
     ///
     /// # Errors
     /// Every invalid name, non-finite number and unparsable expression added, together. The
@@ -483,13 +483,18 @@ impl SceneBuilder {
         Ok(text)
     }
 
-    /// The generated Rust items: [`build`](Self::build), then [`crate::expand_str_with`].
+    /// The generated Rust items: [`build`](Self::build), then [`crate::expand`] with `options`,
+    /// the text read without size and count limits (a program wrote it).
     ///
     /// # Errors
     /// As [`build`](Self::build), then every error of the checker (see the module
     /// documentation on their locations).
     pub fn expand(&self, options: &CodegenOptions) -> Result<TokenStream, Errors> {
-        crate::expand_str_with(&self.build()?, options)
+        let options = crate::Options {
+            limits: crate::Limits::UNBOUNDED_SIZE,
+            codegen: *options,
+        };
+        crate::expand(crate::Input::Text(&self.build()?), &options)
     }
 
     /// Writes the generated items to `path` as unformatted tokens, for `include!`. The file is
@@ -812,7 +817,8 @@ mod tests {
             text.contains("driver spin: angle(crank) = omega * t;"),
             "{text}"
         );
-        let scene = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let scene = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
         assert_eq!(scene.model.dim(), 12);
         let code = slider_crank()
             .expand(&CodegenOptions::default())
@@ -852,7 +858,8 @@ mod tests {
             text.contains("branch up: cross(frame -> crank @ (0.5, 0.0), frame -> slider) < 0;"),
             "{text}"
         );
-        let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let compiled = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
         assert_eq!(compiled.model.branches.len(), 2);
         assert_eq!(compiled.kinematics.branches.len(), 2);
         let mut bad = slider_crank();
@@ -900,7 +907,8 @@ mod tests {
         assert!(text.contains(
             "load coil: spring(frame, weight, stiffness 10.0, length 2.0, damping 0.5);"
         ));
-        let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let compiled = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
         assert_eq!(compiled.model.outputs, crate::model::Outputs::Forces);
         assert_eq!(compiled.model.loads.len(), 4);
         assert!(compiled.forces.is_some());
@@ -920,7 +928,8 @@ mod tests {
             scene.outputs(outputs);
             let text = scene.build().unwrap_or_else(|e| panic!("{e}"));
             assert!(text.contains(line), "{text}");
-            let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+            let compiled = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+                .unwrap_or_else(|e| panic!("{e}\n{text}"));
             assert_eq!(compiled.model.outputs, outputs);
         }
     }
@@ -951,7 +960,8 @@ mod tests {
         scene.revolute("pin", "frame", "b");
         scene.driver_angle("d", "b", "t");
         let text = scene.build().unwrap_or_else(|e| panic!("{e}"));
-        let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let compiled = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
         for (param, &x) in compiled.model.params.iter().zip(&values) {
             // Bit-exact, except that the checker folds `-0.0` to `0.0` (equal as numbers).
             assert!(param.default == x && (x == 0.0 || param.default.to_bits() == x.to_bits()));
@@ -970,7 +980,8 @@ mod tests {
         scene.revolute("pin", "frame", ("b1", [0.0, 0.0]));
         scene.driver_angle("d", "b1", "c * t");
         let text = scene.build().unwrap_or_else(|e| panic!("{e}"));
-        let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let compiled = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
         let model = &compiled.model;
         assert_eq!(model.params.len(), 2);
         assert_eq!(model.derived.len(), 1);

@@ -278,7 +278,8 @@ mod tests {
     use crate::expr::tape::{Env, eval};
 
     fn forces(source: &str, env: &Env) -> Vec<f64> {
-        let scene = crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"));
+        let scene = crate::compile(crate::Input::Text(source), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}"));
         let mut model = scene.model;
         let forces = super::derive(&mut model);
         forces.iter().map(|&f| eval(&model.arena, f, env)).collect()

@@ -143,7 +143,8 @@ mod tests {
     use super::*;
 
     fn checks_of(source: &str) -> (Vec<Check>, crate::Scene) {
-        let scene = crate::compile_str(source).unwrap_or_else(|e| panic!("{:?}", e.messages()));
+        let scene = crate::compile(crate::Input::Text(source), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{:?}", e.messages()));
         (scene.kinematics.geometry.clone(), scene)
     }
 

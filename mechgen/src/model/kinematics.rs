@@ -329,7 +329,8 @@ mod tests {
     use crate::expr::tape::{Env, eval};
 
     fn compile(source: &str) -> crate::Scene {
-        crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"))
+        crate::compile(crate::Input::Text(source), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}"))
     }
 
     #[test]

@@ -52,8 +52,9 @@ mod tests {
 
     #[test]
     fn a_point_and_an_angle_with_their_rates() {
-        let scene = crate::compile_str(
-            "mechanism M {
+        let scene = crate::compile(
+            crate::Input::Text(
+                "mechanism M {
                 ground frame at (0, 0, 0);
                 body arm near (0, 0, 0);
                 body hand near (2, 0, 0);
@@ -64,6 +65,8 @@ mod tests {
                 marker tip: hand @ (1, 0);
                 marker wrist: angle(arm, hand);
             }",
+            ),
+            &crate::Options::default(),
         )
         .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(

@@ -91,8 +91,9 @@ mod tests {
 
     #[test]
     fn only_parameter_dependent_physics_is_checked_and_named() {
-        let scene = crate::compile_str(
-            "mechanism M {
+        let scene = crate::compile(
+            crate::Input::Text(
+                "mechanism M {
                 param m = 2.0;
                 param k = 500.0;
                 ground frame at (0, 0, 0);
@@ -104,6 +105,8 @@ mod tests {
                 driver spin: angle(crank) = t;
                 load coil: spring(frame @ (0.6, 0.1), slider, stiffness k, length 0.2);
             }",
+            ),
+            &crate::Options::default(),
         )
         .unwrap_or_else(|e| panic!("{:?}", e.messages()));
         let found: Vec<(Requirement, Subject, usize)> = scene

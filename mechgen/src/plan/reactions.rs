@@ -420,7 +420,11 @@ mod tests {
     /// The scene's force stages with the first multiplier of stage `s` made to read the
     /// multiplier of `equation`, checked.
     fn check_with_read(s: usize, equation: impl Fn(&[Stage]) -> usize) {
-        let mut scene = crate::compile_str(PRISMATIC_TORQUE).unwrap_or_else(|e| panic!("{e}"));
+        let mut scene = crate::compile(
+            crate::Input::Text(PRISMATIC_TORQUE),
+            &crate::Options::default(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
         let mut stages = scene.forces.expect("computes forces").stages;
         let n = scene.kinematics.phi.len();
         let read = equation(&scene.plan.stages);
@@ -439,7 +443,11 @@ mod tests {
 
     #[test]
     fn the_planned_stages_read_only_later_multipliers() {
-        let scene = crate::compile_str(PRISMATIC_TORQUE).unwrap_or_else(|e| panic!("{e}"));
+        let scene = crate::compile(
+            crate::Input::Text(PRISMATIC_TORQUE),
+            &crate::Options::default(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
         let stages = scene.forces.expect("computes forces").stages;
         assert!(stages.len() >= 2, "a fixed stage and the driver's");
         let n = scene.kinematics.phi.len();
