@@ -12,7 +12,7 @@
 //! ```
 //!
 //! - [`syntax`]: the input limits, the bounded reader of `.mech` text, the grammar (documented
-//!   in [`syntax::parse`]) and the [`Spec`](syntax::spec::Spec) it builds;
+//!   in [`syntax::parse`]) and the [`Spec`] it builds;
 //! - [`check`]: names resolved, values lowered to the IR, degrees of freedom counted, every
 //!   error at its span; its result is a [`Model`];
 //! - [`model`]: the checked model and what is derived from it: Φ and its derivatives, markers,
@@ -135,8 +135,8 @@ fn scene(mut model: Model) -> Scene {
 }
 
 /// The whole pipeline: [`compile`], then [`emit`] with [`Options::codegen`]. What a `build.rs`
-/// writes into `OUT_DIR` (see [`builder`] for assembling large scenes in code); [`pretty`]
-/// formats it for reading.
+/// writes into `OUT_DIR` (see [`builder`] for assembling large scenes in code); `pretty`
+/// (feature `pretty`) formats it for reading.
 ///
 /// # Errors
 /// As [`compile`].

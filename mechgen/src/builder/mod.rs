@@ -36,113 +36,22 @@
 //! `pretty` feature, `SceneBuilder::write_pretty_to`) adds nothing for rustc and costs more
 //! than the expansion itself on large scenes.
 
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+mod text;
+mod values;
+mod write;
 
-use proc_macro2::{Delimiter, Spacing, Span, TokenStream, TokenTree};
+pub use crate::syntax::spec::{Product, Sign};
+pub use text::source_text;
+pub use values::{Point, Value};
+pub use write::WriteError;
+
+use std::fmt::Write as _;
+
+use proc_macro2::{Span, TokenStream};
 
 use crate::emit::CodegenOptions;
 use crate::error::Errors;
 use crate::model::Outputs;
-pub use crate::syntax::spec::{Product, Sign};
-
-/// A scalar of the spec: a number, or an expression in parameters (and `t` in drivers) written
-/// in the grammar's syntax, e.g. `"omega * t"` or `"0.5 * sin(2 * t)"`.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Value {
-    /// A finite number, written with its shortest round-trip representation.
-    Number(f64),
-    /// An expression in the grammar's syntax; checked for syntax when added.
-    Expr(String),
-}
-
-impl From<f64> for Value {
-    fn from(value: f64) -> Self {
-        Value::Number(value)
-    }
-}
-
-impl From<&str> for Value {
-    fn from(expr: &str) -> Self {
-        Value::Expr(expr.to_owned())
-    }
-}
-
-impl From<String> for Value {
-    fn from(expr: String) -> Self {
-        Value::Expr(expr)
-    }
-}
-
-impl From<&String> for Value {
-    fn from(expr: &String) -> Self {
-        Value::Expr(expr.clone())
-    }
-}
-
-/// A body-fixed point: a body's reference point (`"crank"`) or a point in its frame
-/// (`("crank", [0.0, 43.0])`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Point {
-    /// The body the point is fixed to.
-    pub body: String,
-    /// Body-frame coordinates; `None` for the reference point.
-    pub local: Option<[f64; 2]>,
-}
-
-impl Point {
-    /// The point at `local` in `body`'s frame.
-    pub fn new(body: impl Into<String>, local: [f64; 2]) -> Self {
-        Point {
-            body: body.into(),
-            local: Some(local),
-        }
-    }
-
-    /// The reference point (origin) of `body`.
-    pub fn origin(body: impl Into<String>) -> Self {
-        Point {
-            body: body.into(),
-            local: None,
-        }
-    }
-}
-
-impl From<&str> for Point {
-    fn from(body: &str) -> Self {
-        Point::origin(body)
-    }
-}
-
-impl From<String> for Point {
-    fn from(body: String) -> Self {
-        Point::origin(body)
-    }
-}
-
-impl From<&String> for Point {
-    fn from(body: &String) -> Self {
-        Point::origin(body.as_str())
-    }
-}
-
-impl From<(&str, [f64; 2])> for Point {
-    fn from((body, local): (&str, [f64; 2])) -> Self {
-        Point::new(body, local)
-    }
-}
-
-impl From<(String, [f64; 2])> for Point {
-    fn from((body, local): (String, [f64; 2])) -> Self {
-        Point::new(body, local)
-    }
-}
-
-impl From<(&String, [f64; 2])> for Point {
-    fn from((body, local): (&String, [f64; 2])) -> Self {
-        Point::new(body.as_str(), local)
-    }
-}
 
 /// One statement of the scene, already rendered, with its doc lines.
 struct Item {
@@ -497,53 +406,6 @@ impl SceneBuilder {
         crate::expand(crate::Input::Text(&self.build()?), &options)
     }
 
-    /// Writes the generated items to `path` as unformatted tokens, for `include!`. The file is
-    /// left untouched when it already holds exactly this text, so that nothing downstream is
-    /// rebuilt needlessly.
-    ///
-    /// # Errors
-    /// The scene's errors, or the file could not be written.
-    pub fn write_to(
-        &self,
-        path: impl AsRef<Path>,
-        options: &CodegenOptions,
-    ) -> Result<(), WriteError> {
-        let code = self.expand(options).map_err(WriteError::Scene)?;
-        write_if_changed(path.as_ref(), &generated_file(&source_text(code)))
-    }
-
-    /// As [`write_to`](Self::write_to), formatted with prettyplease for reading (much slower
-    /// on large scenes).
-    ///
-    /// # Errors
-    /// As [`write_to`](Self::write_to).
-    #[cfg(feature = "pretty")]
-    pub fn write_pretty_to(
-        &self,
-        path: impl AsRef<Path>,
-        options: &CodegenOptions,
-    ) -> Result<(), WriteError> {
-        let code = self.expand(options).map_err(WriteError::Scene)?;
-        write_if_changed(path.as_ref(), &generated_file(&crate::pretty(code)))
-    }
-
-    /// [`write_to`](Self::write_to) into `$OUT_DIR/file_name`, for a build script; returns the
-    /// path written. The crate then says `include!(concat!(env!("OUT_DIR"), "/FILE_NAME"));`.
-    ///
-    /// # Errors
-    /// As [`write_to`](Self::write_to), or `OUT_DIR` is not set (not running under Cargo as a
-    /// build script).
-    pub fn write_to_out_dir(
-        &self,
-        file_name: &str,
-        options: &CodegenOptions,
-    ) -> Result<PathBuf, WriteError> {
-        let out_dir = std::env::var_os("OUT_DIR").ok_or(WriteError::NoOutDir)?;
-        let path = Path::new(&out_dir).join(file_name);
-        self.write_to(&path, options)?;
-        Ok(path)
-    }
-
     /// Records `text` as the next statement.
     fn push(&mut self, text: String) -> &mut Self {
         self.items.push(Item {
@@ -626,72 +488,6 @@ impl SceneBuilder {
     }
 }
 
-/// Generated tokens as source text, one statement or brace per line: what
-/// [`SceneBuilder::write_to`] writes. Linear in the size of the code, unlike formatting.
-///
-/// Why not `TokenStream::to_string()`: it puts everything on one line, and rustc's cost of
-/// locating a span (every bounds check's panic location) grows with the length of its line, so
-/// a multi-megabyte line makes the including crate's release build several times slower
-/// (measured: 22 s against 4 s for a 600 kB scene).
-pub fn source_text(tokens: TokenStream) -> String {
-    let mut text = String::new();
-    // Iterative: generated code nests shallowly, but this must not recurse on its input anyway.
-    // Each open group: its tokens, its delimiter, and whether it is an attribute (`#[…]`, which
-    // ends its line: doc comments come in long runs).
-    let mut stack = vec![(tokens.into_iter(), Delimiter::None, false)];
-    while let Some((iter, delimiter, attribute)) = stack.last_mut() {
-        let (delimiter, attribute) = (*delimiter, *attribute);
-        match iter.next() {
-            None => {
-                stack.pop();
-                match delimiter {
-                    Delimiter::Brace => text.push_str("}\n"),
-                    Delimiter::Parenthesis => text.push_str(") "),
-                    Delimiter::Bracket if attribute => text.push_str("]\n"),
-                    Delimiter::Bracket => text.push_str("] "),
-                    Delimiter::None => {}
-                }
-            }
-            Some(TokenTree::Group(group)) => {
-                let attribute = text.ends_with("# ") || text.ends_with('#');
-                match group.delimiter() {
-                    Delimiter::Brace => text.push_str("{\n"),
-                    Delimiter::Parenthesis => text.push('('),
-                    Delimiter::Bracket => text.push('['),
-                    Delimiter::None => {}
-                }
-                stack.push((group.stream().into_iter(), group.delimiter(), attribute));
-            }
-            Some(TokenTree::Punct(punct)) => {
-                text.push(punct.as_char());
-                match (punct.spacing(), punct.as_char()) {
-                    // Joint: part of `::`, `->`, `'a`, …; no space inside.
-                    (Spacing::Joint, _) => {}
-                    // A statement's end, but not `[T; N]`.
-                    (Spacing::Alone, ';') if delimiter != Delimiter::Bracket => text.push('\n'),
-                    // Long lists (the Jacobian's pattern, the coordinate names) wrap.
-                    (Spacing::Alone, ',') if text.len() - line_start(&text) > 100 => {
-                        text.push('\n');
-                    }
-                    (Spacing::Alone, _) => text.push(' '),
-                }
-            }
-            Some(TokenTree::Ident(ident)) => {
-                let _ = write!(text, "{ident} ");
-            }
-            Some(TokenTree::Literal(literal)) => {
-                let _ = write!(text, "{literal} ");
-            }
-        }
-    }
-    text
-}
-
-/// Byte offset at which the last line of `text` starts.
-fn line_start(text: &str) -> usize {
-    text.rfind('\n').map_or(0, |i| i + 1)
-}
-
 /// `source` checked as one expression of the grammar and re-rendered from its tokens, so that a
 /// comment in it cannot swallow the rest of the statement.
 fn expression(source: &str) -> Result<String, String> {
@@ -715,69 +511,6 @@ fn doc_lines(text: &str) -> impl Iterator<Item = String> + '_ {
             format!(" {line}")
         }
     })
-}
-
-/// The file written for `include!`: a plain (not inner-doc) header comment, which `include!`
-/// accepts, then the items.
-fn generated_file(code: &str) -> String {
-    format!("// Generated by mechgen::builder: do not edit.\n{code}\n")
-}
-
-fn write_if_changed(path: &Path, contents: &str) -> Result<(), WriteError> {
-    if std::fs::read(path).is_ok_and(|old| old == contents.as_bytes()) {
-        return Ok(());
-    }
-    std::fs::write(path, contents).map_err(|source| WriteError::Io {
-        path: path.to_owned(),
-        source,
-    })
-}
-
-/// Why [`SceneBuilder::write_to`] (or `write_to_out_dir`) failed.
-#[derive(Debug)]
-pub enum WriteError {
-    /// The scene has errors.
-    Scene(Errors),
-    /// The file could not be written.
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// What went wrong.
-        source: std::io::Error,
-    },
-    /// `OUT_DIR` is not set: `write_to_out_dir` is meant for a build script run by Cargo.
-    NoOutDir,
-}
-
-impl std::fmt::Display for WriteError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            WriteError::Scene(errors) => write!(f, "{errors}"),
-            WriteError::Io { path, source } => {
-                write!(f, "cannot write {}: {source}", path.display())
-            }
-            WriteError::NoOutDir => f.write_str(
-                "OUT_DIR is not set: `write_to_out_dir` is for build scripts run by Cargo; \
-                 use `write_to` with an explicit path elsewhere",
-            ),
-        }
-    }
-}
-
-impl std::error::Error for WriteError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            WriteError::Scene(errors) => Some(errors),
-            WriteError::Io { source, .. } => Some(source),
-            WriteError::NoOutDir => None,
-        }
-    }
-}
-
-impl From<Errors> for WriteError {
-    fn from(errors: Errors) -> Self {
-        WriteError::Scene(errors)
-    }
 }
 
 #[cfg(test)]
