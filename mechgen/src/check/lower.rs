@@ -3,6 +3,7 @@
 //! rules, and constants that fold to NaN or infinity reported.
 
 use proc_macro2::Span;
+use syn::Ident;
 
 use super::names::did_you_mean;
 use super::{Checker, resolution};
@@ -59,55 +60,7 @@ impl Checker {
     pub(super) fn lower_with(&mut self, e: &Expr, allow_params: bool, allow_t: bool) -> Id {
         match &e.kind {
             ExprKind::Number(v) => self.arena.constant(*v),
-            ExprKind::Name(name) => {
-                let key = name.to_string();
-                if key == "pi" {
-                    return self.arena.constant(core::f64::consts::PI);
-                }
-                if key == "t" {
-                    if !allow_t {
-                        self.errors.push(
-                            name.span(),
-                            "time `t` can only appear in a driver's value; geometry and \
-                             defaults are constant or use parameters",
-                        );
-                    }
-                    return self.arena.var(Var::T);
-                }
-                if let Some(&value) = self.derived.get(&key) {
-                    return self.derived_value(name, value, allow_params);
-                }
-                match self.params.get(&key) {
-                    Some(&index) if allow_params => self.arena.param(index),
-                    Some(_) => {
-                        self.errors.push(
-                            name.span(),
-                            "a parameter default must be a number, not another parameter",
-                        );
-                        self.arena.zero()
-                    }
-                    None => {
-                        let mut names: Vec<(&String, &u32)> = self.params.iter().collect();
-                        names.sort_by_key(|(_, i)| **i);
-                        let close =
-                            did_you_mean(&key, names.iter().map(|(n, _)| n.as_str()).chain(["t"]));
-                        let hint = if let Some(close) = close {
-                            format!("did you mean `{close}`?")
-                        } else if names.is_empty() {
-                            "declare it with `param NAME = VALUE;`".to_owned()
-                        } else {
-                            let list: Vec<String> =
-                                names.iter().map(|(n, _)| format!("`{n}`")).collect();
-                            format!("declared parameters are {}", list.join(", "))
-                        };
-                        self.errors.push(
-                            name.span(),
-                            format!("unknown name `{key}`: not `t` or a parameter; {hint}"),
-                        );
-                        self.arena.zero()
-                    }
-                }
-            }
+            ExprKind::Name(name) => self.lower_name(name, allow_params, allow_t),
             ExprKind::Neg(a) => {
                 let a = self.lower_with(a, allow_params, allow_t);
                 self.arena.neg(a)
@@ -152,6 +105,56 @@ impl Checker {
                     e.span,
                     "a pair `(x, y)` only appears as a spline's point, as in \
                      `spline(t, (0, 0), (1, 2))`",
+                );
+                self.arena.zero()
+            }
+        }
+    }
+
+    /// A name in a value: `pi`, `t` (where time is allowed), a derived or a run-time parameter
+    /// (where parameters are allowed), or an error with the name meant.
+    fn lower_name(&mut self, name: &Ident, allow_params: bool, allow_t: bool) -> Id {
+        let key = name.to_string();
+        if key == "pi" {
+            return self.arena.constant(core::f64::consts::PI);
+        }
+        if key == "t" {
+            if !allow_t {
+                self.errors.push(
+                    name.span(),
+                    "time `t` can only appear in a driver's value; geometry and \
+                     defaults are constant or use parameters",
+                );
+            }
+            return self.arena.var(Var::T);
+        }
+        if let Some(&value) = self.derived.get(&key) {
+            return self.derived_value(name, value, allow_params);
+        }
+        match self.params.get(&key) {
+            Some(&index) if allow_params => self.arena.param(index),
+            Some(_) => {
+                self.errors.push(
+                    name.span(),
+                    "a parameter default must be a number, not another parameter",
+                );
+                self.arena.zero()
+            }
+            None => {
+                let mut names: Vec<(&String, &u32)> = self.params.iter().collect();
+                names.sort_by_key(|(_, i)| **i);
+                let close = did_you_mean(&key, names.iter().map(|(n, _)| n.as_str()).chain(["t"]));
+                let hint = if let Some(close) = close {
+                    format!("did you mean `{close}`?")
+                } else if names.is_empty() {
+                    "declare it with `param NAME = VALUE;`".to_owned()
+                } else {
+                    let list: Vec<String> = names.iter().map(|(n, _)| format!("`{n}`")).collect();
+                    format!("declared parameters are {}", list.join(", "))
+                };
+                self.errors.push(
+                    name.span(),
+                    format!("unknown name `{key}`: not `t` or a parameter; {hint}"),
                 );
                 self.arena.zero()
             }

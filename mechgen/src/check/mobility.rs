@@ -68,144 +68,165 @@ impl Checker {
                 dof.to_string()
             },
         );
-        // The joints (and drivers) whose equations the others already impose, last declared
-        // first: the likeliest to have been added by mistake.
-        // A pin repeating an earlier one comes first, alone (its equations are the other's).
         let over = structure.over_constraints(model);
-        let mut removable = redundancy::removable(model, rows, structure.rank, &over);
-        removable.reverse();
-        if let Some(&(later, earlier)) = redundancy::repeated_pins(model, &over).last() {
-            removable = vec![later, earlier];
-        }
-        let ground = model.bodies.iter().filter(|b| b.ground).count();
-        let joints: Vec<&Ident> = removable
-            .iter()
-            .filter_map(|&k| spec.joints.get(k.checked_sub(ground)?).map(|j| &j.name))
-            .collect();
+        let joints = removable_joints(spec, model, rows, structure, &over);
         if dof < 0 {
-            let part = if structure.over_equations.is_empty() {
-                String::new()
-            } else {
-                format!(
-                    "; {} over-determine {} ({})",
-                    structure.statements(model),
-                    structure.over_bodies(model),
-                    structure.over_count(),
-                )
-            };
-            // No joint whose equations are all redundant (without drivers, removing any
-            // joint frees a coordinate): the error goes to the last joint of the part.
-            let last = over
-                .iter()
-                .rev()
-                .find_map(|&k| spec.joints.get(k.checked_sub(ground)?));
-            let (span, fix) = match (joints.split_first(), last) {
-                (Some((first, others)), _) => (
-                    first.span(),
-                    format!(
-                        "{}: the other constraints already impose its equations",
-                        remove_joint(first, others)
-                    ),
-                ),
-                (None, Some(last)) => (last.name.span(), "remove joints or add bodies".to_owned()),
-                (None, None) => (spec.name.span(), "remove joints or add bodies".to_owned()),
-            };
-            self.errors.push(
-                span,
-                format!("the joints over-constrain the mechanism ({count}){part}; {fix}"),
-            );
+            self.over_constrained(spec, model, structure, &over, &joints, &count);
         } else if dof == 0 && drivers > 0 && !joints.is_empty() {
             // Drivers on a mechanism its joints hold rigid: a joint closed a loop twice.
             self.joint_takes_drivers_freedom(spec, &joints, dof, &count);
         } else if drivers < dof {
-            let missing = dof - drivers;
-            let example = spec
-                .bodies
-                .iter()
-                .find(|b| !b.ground)
-                .map_or_else(|| "BODY".to_owned(), |b| b.name.to_string());
-            let taken = |name: &str| {
-                let params = spec.params.iter().map(|p| &p.name);
-                let joints = spec.joints.iter().map(|j| &j.name);
-                let drivers = spec.drivers.iter().map(|d| &d.name);
-                self.bodies.contains_key(name)
-                    || params.chain(joints).chain(drivers).any(|n| n == name)
-            };
-            let spin = (1..)
-                .map(|k| {
-                    if k == 1 {
-                        "spin".to_owned()
-                    } else {
-                        format!("spin{k}")
-                    }
-                })
-                .find(|name| !taken(name))
-                .unwrap_or_default();
-            self.errors.push(
-                spec.name.span(),
-                format!(
-                    "`{}` has {dof} degree{} of freedom but {drivers} driver{} ({count}); add \
-                     {missing} driver{}, e.g. `driver {spin}: angle({example}) = t;`",
-                    spec.name,
-                    plural(dof),
-                    plural(drivers),
-                    plural(missing),
-                ),
-            );
+            self.too_few_drivers(spec, dof, &count);
         } else if drivers > dof {
-            let extra = drivers - dof;
-            for driver in spec.drivers.iter().skip(dof as usize) {
-                self.errors.push(
-                    driver.name.span(),
-                    format!(
-                        "too many drivers: `{}` has {dof} degree{} of freedom but {drivers} \
-                         driver{} ({count}); remove {extra} driver{}, such as `{}`",
-                        spec.name,
-                        plural(dof),
-                        plural(drivers),
-                        plural(extra),
-                        driver.name,
-                    ),
-                );
-            }
+            self.too_many_drivers(spec, dof, &count);
         } else if !structure.over_equations.is_empty() {
-            let free: Vec<String> = structure
-                .under_free
-                .iter()
-                .map(|&c| format!("`{}`", coordinate_name(model, c)))
-                .collect();
-            let under = structure.under_bodies(model);
-            let message = format!(
-                "structurally redundant constraints: {} over-determine {} ({}) while {} keep{} \
-                 {} coordinate{} free ({}), so the Jacobian is singular in every position \
-                 although the Gruebler count matches; remove one of these constraints and \
-                 constrain {} instead",
+            self.structurally_redundant(spec, model, structure);
+        }
+    }
+
+    /// More joint equations than coordinates: the error goes to the joint whose equations the
+    /// others already impose, else to the last joint of the over-determined part.
+    fn over_constrained(
+        &mut self,
+        spec: &Spec,
+        model: &Model,
+        structure: &Structure,
+        over: &[usize],
+        joints: &[&Ident],
+        count: &str,
+    ) {
+        let ground = model.bodies.iter().filter(|b| b.ground).count();
+        let part = if structure.over_equations.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; {} over-determine {} ({})",
                 structure.statements(model),
                 structure.over_bodies(model),
                 structure.over_count(),
-                under,
-                if structure.under_body_count(model) == 1 {
-                    "s"
+            )
+        };
+        // No joint whose equations are all redundant (without drivers, removing any
+        // joint frees a coordinate): the error goes to the last joint of the part.
+        let last = over
+            .iter()
+            .rev()
+            .find_map(|&k| spec.joints.get(k.checked_sub(ground)?));
+        let (span, fix) = match (joints.split_first(), last) {
+            (Some((first, others)), _) => (
+                first.span(),
+                format!(
+                    "{}: the other constraints already impose its equations",
+                    remove_joint(first, others)
+                ),
+            ),
+            (None, Some(last)) => (last.name.span(), "remove joints or add bodies".to_owned()),
+            (None, None) => (spec.name.span(), "remove joints or add bodies".to_owned()),
+        };
+        self.errors.push(
+            span,
+            format!("the joints over-constrain the mechanism ({count}){part}; {fix}"),
+        );
+    }
+
+    /// Fewer drivers than degrees of freedom: the error at the mechanism's name, with a driver
+    /// to add under a free name.
+    fn too_few_drivers(&mut self, spec: &Spec, dof: i64, count: &str) {
+        let drivers = spec.drivers.len() as i64;
+        let missing = dof - drivers;
+        let example = spec
+            .bodies
+            .iter()
+            .find(|b| !b.ground)
+            .map_or_else(|| "BODY".to_owned(), |b| b.name.to_string());
+        let taken = |name: &str| {
+            let params = spec.params.iter().map(|p| &p.name);
+            let joints = spec.joints.iter().map(|j| &j.name);
+            let drivers = spec.drivers.iter().map(|d| &d.name);
+            self.bodies.contains_key(name) || params.chain(joints).chain(drivers).any(|n| n == name)
+        };
+        let spin = (1..)
+            .map(|k| {
+                if k == 1 {
+                    "spin".to_owned()
                 } else {
-                    ""
-                },
-                free.len(),
-                plural(free.len() as i64),
-                free.join(", "),
-                under,
+                    format!("spin{k}")
+                }
+            })
+            .find(|name| !taken(name))
+            .unwrap_or_default();
+        self.errors.push(
+            spec.name.span(),
+            format!(
+                "`{}` has {dof} degree{} of freedom but {drivers} driver{} ({count}); add \
+                 {missing} driver{}, e.g. `driver {spin}: angle({example}) = t;`",
+                spec.name,
+                plural(dof),
+                plural(drivers),
+                plural(missing),
+            ),
+        );
+    }
+
+    /// More drivers than degrees of freedom: the error at each driver past the count.
+    fn too_many_drivers(&mut self, spec: &Spec, dof: i64, count: &str) {
+        let drivers = spec.drivers.len() as i64;
+        let extra = drivers - dof;
+        for driver in spec.drivers.iter().skip(dof as usize) {
+            self.errors.push(
+                driver.name.span(),
+                format!(
+                    "too many drivers: `{}` has {dof} degree{} of freedom but {drivers} \
+                     driver{} ({count}); remove {extra} driver{}, such as `{}`",
+                    spec.name,
+                    plural(dof),
+                    plural(drivers),
+                    plural(extra),
+                    driver.name,
+                ),
             );
-            let ground = model.bodies.iter().filter(|b| b.ground).count();
-            for &k in &structure.over_constraints(model) {
-                let span = match k.checked_sub(ground) {
-                    Some(j) if j < spec.joints.len() => spec.joints[j].name.span(),
-                    Some(j) => spec
-                        .drivers
-                        .get(j - spec.joints.len())
-                        .map_or(spec.name.span(), |d| d.name.span()),
-                    None => spec.name.span(),
-                };
-                self.errors.push(span, &message);
-            }
+        }
+    }
+
+    /// A square system that is structurally singular: the error at every constraint of the
+    /// over-determined part, naming the coordinates the under-determined part leaves free.
+    fn structurally_redundant(&mut self, spec: &Spec, model: &Model, structure: &Structure) {
+        let free: Vec<String> = structure
+            .under_free
+            .iter()
+            .map(|&c| format!("`{}`", coordinate_name(model, c)))
+            .collect();
+        let under = structure.under_bodies(model);
+        let message = format!(
+            "structurally redundant constraints: {} over-determine {} ({}) while {} keep{} \
+             {} coordinate{} free ({}), so the Jacobian is singular in every position \
+             although the Gruebler count matches; remove one of these constraints and \
+             constrain {} instead",
+            structure.statements(model),
+            structure.over_bodies(model),
+            structure.over_count(),
+            under,
+            if structure.under_body_count(model) == 1 {
+                "s"
+            } else {
+                ""
+            },
+            free.len(),
+            plural(free.len() as i64),
+            free.join(", "),
+            under,
+        );
+        let ground = model.bodies.iter().filter(|b| b.ground).count();
+        for &k in &structure.over_constraints(model) {
+            let span = match k.checked_sub(ground) {
+                Some(j) if j < spec.joints.len() => spec.joints[j].name.span(),
+                Some(j) => spec
+                    .drivers
+                    .get(j - spec.joints.len())
+                    .map_or(spec.name.span(), |d| d.name.span()),
+                None => spec.name.span(),
+            };
+            self.errors.push(span, &message);
         }
     }
 
@@ -265,4 +286,28 @@ pub(super) fn remove_joint(first: &Ident, others: &[&Ident]) -> String {
         format!(" (or {})", names.join(", "))
     };
     format!("remove joint `{first}`{or}")
+}
+
+/// The joints whose equations the other constraints already impose (`over`: the constraints
+/// of the over-determined part).
+fn removable_joints<'a>(
+    spec: &'a Spec,
+    model: &Model,
+    rows: &[Vec<usize>],
+    structure: &Structure,
+    over: &[usize],
+) -> Vec<&'a Ident> {
+    // The joints (and drivers) whose equations the others already impose, last declared
+    // first: the likeliest to have been added by mistake.
+    // A pin repeating an earlier one comes first, alone (its equations are the other's).
+    let mut removable = redundancy::removable(model, rows, structure.rank, over);
+    removable.reverse();
+    if let Some(&(later, earlier)) = redundancy::repeated_pins(model, over).last() {
+        removable = vec![later, earlier];
+    }
+    let ground = model.bodies.iter().filter(|b| b.ground).count();
+    removable
+        .iter()
+        .filter_map(|&k| spec.joints.get(k.checked_sub(ground)?).map(|j| &j.name))
+        .collect()
 }

@@ -59,75 +59,15 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
     let mut errors = Errors::default();
     let substituted = points::substitute(spec, &mut errors);
     let spec = substituted.as_ref().unwrap_or(spec);
-    let mut cx = Checker {
-        errors,
-        arena,
-        bodies: HashMap::new(),
-        params: HashMap::new(),
-        derived: HashMap::new(),
-        computing: None,
-        points: HashMap::new(),
-        prismatic: HashMap::new(),
-        ground: Vec::new(),
-        lengths: Lengths::default(),
-    };
+    let mut cx = Checker::new(errors, arena);
     cx.check_names(spec);
     let outputs = cx.outputs(spec);
 
     let (params, derived) = cx.parameters(spec);
     cx.ground = spec.bodies.iter().map(|b| b.ground).collect();
 
-    let bodies: Vec<Body> = spec
-        .bodies
-        .iter()
-        .map(|b| Body {
-            name: b.name.clone(),
-            docs: b.docs.clone(),
-            ground: b.ground,
-            pose: {
-                // A ground body's position is scene geometry; a guess is only a start.
-                let [x, y, angle] = &b.pose;
-                let (x, y) = if b.ground {
-                    (cx.length(x), cx.length(y))
-                } else {
-                    (cx.geometry(x), cx.geometry(y))
-                };
-                [x, y, cx.angle(angle)]
-            },
-            mass: cx.mass(b),
-        })
-        .collect();
-
-    let mut constraints: Vec<Constraint> = bodies
-        .iter()
-        .enumerate()
-        .filter(|(_, b)| b.ground)
-        .map(|(i, b)| Constraint {
-            name: b.name.to_string(),
-            kind: ConstraintKind::Ground {
-                body: i,
-                pose: b.pose,
-            },
-        })
-        .collect();
-    for joint in &spec.joints {
-        if let Some(kind) = cx.joint(&joint.name, &joint.kind) {
-            constraints.push(Constraint {
-                name: joint.name.to_string(),
-                kind,
-            });
-        }
-    }
-    for driver in &spec.drivers {
-        let driven = cx.driven(driver.kind_span, &driver.kind);
-        let value = cx.lower(&driver.value, true);
-        if let Some(driven) = driven {
-            constraints.push(Constraint {
-                name: driver.name.to_string(),
-                kind: ConstraintKind::Driver { driven, value },
-            });
-        }
-    }
+    let bodies = cx.bodies(spec);
+    let constraints = cx.constraints(spec, &bodies);
     let branches: Vec<Branch> = spec
         .branches
         .iter()
@@ -169,6 +109,8 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
     Ok(model)
 }
 
+/// The checker's state while it walks a spec: the errors so far, the arena it lowers into and
+/// the name tables.
 struct Checker {
     errors: Errors,
     arena: Arena,
@@ -186,6 +128,82 @@ struct Checker {
     ground: Vec<bool>,
     /// Constant lengths, for the range and resolution rules.
     lengths: Lengths,
+}
+
+impl Checker {
+    fn new(errors: Errors, arena: Arena) -> Self {
+        Checker {
+            errors,
+            arena,
+            bodies: HashMap::new(),
+            params: HashMap::new(),
+            derived: HashMap::new(),
+            computing: None,
+            points: HashMap::new(),
+            prismatic: HashMap::new(),
+            ground: Vec::new(),
+            lengths: Lengths::default(),
+        }
+    }
+
+    /// The bodies with their poses (a ground body's position is scene geometry, a moving
+    /// body's a guess) and mass properties.
+    fn bodies(&mut self, spec: &Spec) -> Vec<Body> {
+        spec.bodies
+            .iter()
+            .map(|b| Body {
+                name: b.name.clone(),
+                docs: b.docs.clone(),
+                ground: b.ground,
+                pose: {
+                    // A ground body's position is scene geometry; a guess is only a start.
+                    let [x, y, angle] = &b.pose;
+                    let (x, y) = if b.ground {
+                        (self.length(x), self.length(y))
+                    } else {
+                        (self.geometry(x), self.geometry(y))
+                    };
+                    [x, y, self.angle(angle)]
+                },
+                mass: self.mass(b),
+            })
+            .collect()
+    }
+
+    /// The constraints in equation order: ground poses, then joints, then drivers.
+    fn constraints(&mut self, spec: &Spec, bodies: &[Body]) -> Vec<Constraint> {
+        let mut constraints: Vec<Constraint> = bodies
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| b.ground)
+            .map(|(i, b)| Constraint {
+                name: b.name.to_string(),
+                kind: ConstraintKind::Ground {
+                    body: i,
+                    pose: b.pose,
+                },
+            })
+            .collect();
+        for joint in &spec.joints {
+            if let Some(kind) = self.joint(&joint.name, &joint.kind) {
+                constraints.push(Constraint {
+                    name: joint.name.to_string(),
+                    kind,
+                });
+            }
+        }
+        for driver in &spec.drivers {
+            let driven = self.driven(driver.kind_span, &driver.kind);
+            let value = self.lower(&driver.value, true);
+            if let Some(driven) = driven {
+                constraints.push(Constraint {
+                    name: driver.name.to_string(),
+                    kind: ConstraintKind::Driver { driven, value },
+                });
+            }
+        }
+        constraints
+    }
 }
 
 fn plural(n: i64) -> &'static str {
