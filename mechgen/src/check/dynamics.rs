@@ -119,6 +119,27 @@ impl Checker {
         ];
         let (pa, pb) = (self.point(a), self.point(b));
         let (pa, pb) = (pa?, pb?);
+        let terms = self.spring_terms(span, stiffness, length, damping);
+        let ends = self.spring_ends(a, b, pa, pb);
+        let valid = terms && ends;
+        let [stiffness, length, damping] = constants;
+        valid.then_some(LoadKind::Spring {
+            a: pa,
+            b: pb,
+            stiffness,
+            length,
+            damping,
+        })
+    }
+
+    /// A stiffness with its free length, or a damping, or both; reports what is missing.
+    fn spring_terms(
+        &mut self,
+        span: Span,
+        stiffness: &Option<Expr>,
+        length: &Option<Expr>,
+        damping: &Option<Expr>,
+    ) -> bool {
         let mut valid = true;
         if stiffness.is_none() && damping.is_none() {
             self.errors.push(
@@ -146,6 +167,12 @@ impl Checker {
             }
             _ => {}
         }
+        valid
+    }
+
+    /// Two ends on different bodies, not both fixed; reports which rule they break.
+    fn spring_ends(&mut self, a: &PointRef, b: &PointRef, pa: Point, pb: Point) -> bool {
+        let mut valid = true;
         if pa.body == pb.body {
             self.errors.push(
                 b.body.span(),
@@ -167,14 +194,7 @@ impl Checker {
             );
             valid = false;
         }
-        let [stiffness, length, damping] = constants;
-        valid.then_some(LoadKind::Spring {
-            a: pa,
-            b: pb,
-            stiffness,
-            length,
-            damping,
-        })
+        valid
     }
 
     /// The point a force acts at, on a moving body.

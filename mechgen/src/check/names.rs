@@ -1,13 +1,13 @@
 //! The scene's names: every declaration's name unique (they share the generated namespace),
 //! references to bodies and points resolved, and for a misspelt name the declared one meant.
 
-use std::collections::{HashMap, HashSet};
+use std::collections::HashMap;
 
 use syn::Ident;
 
 use super::Checker;
 use crate::model::Point;
-use crate::syntax::spec::{Expr, ExprKind, PointRef, Spec};
+use crate::syntax::spec::{PointRef, Spec};
 
 impl Checker {
     /// Every declared name is unique across parameters, bodies, joints, drivers, branches,
@@ -60,22 +60,7 @@ impl Checker {
                 .entry(point.name.to_string())
                 .or_insert_with(|| point.point.body.to_string());
         }
-        // A parameter whose default names another is derived; the others are run-time
-        // parameters, indexed in declaration order.
-        let declared: HashSet<String> = spec.params.iter().map(|p| p.name.to_string()).collect();
-        let mut index = 0;
-        for param in &spec.params {
-            let key = param.name.to_string();
-            if self.params.contains_key(&key) || self.derived.contains_key(&key) {
-                continue;
-            }
-            if names_any(&param.default, &declared) {
-                self.derived.insert(key, None);
-            } else {
-                self.params.insert(key, crate::expr::var_index(index));
-                index += 1;
-            }
-        }
+        self.classify_parameters(spec);
         if !spec.bodies.iter().any(|b| !b.ground) {
             self.errors.push(
                 spec.name.span(),
@@ -124,19 +109,6 @@ impl Checker {
             None => [self.arena.zero(), self.arena.zero()],
         };
         Some(Point { body, local })
-    }
-}
-
-/// Whether `e` names any of `names` (function names excluded).
-pub(super) fn names_any(e: &Expr, names: &HashSet<String>) -> bool {
-    match &e.kind {
-        ExprKind::Number(_) => false,
-        ExprKind::Name(name) => names.contains(&name.to_string()),
-        ExprKind::Neg(a) | ExprKind::Pow(a, _) => names_any(a, names),
-        ExprKind::Binary(_, a, b) | ExprKind::RealPow(a, b) => {
-            names_any(a, names) || names_any(b, names)
-        }
-        ExprKind::Call(_, args) | ExprKind::Tuple(args) => args.iter().any(|a| names_any(a, names)),
     }
 }
 

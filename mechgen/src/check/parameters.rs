@@ -1,14 +1,36 @@
-//! Parameters: the run-time ones with their constant defaults, and the derived ones lowered
-//! as expressions of those declared before them.
+//! Parameters: which are derived (their default names another) and which are set at run time;
+//! the run-time ones' constant defaults, and the derived ones lowered as expressions of those
+//! declared before them.
+
+use std::collections::HashSet;
 
 use syn::Ident;
 
 use super::Checker;
 use crate::expr::{Id, Node};
 use crate::model::{Derived, Param};
-use crate::syntax::spec::{Expr, Spec};
+use crate::syntax::spec::{Expr, ExprKind, Spec};
 
 impl Checker {
+    /// Which parameters are derived (their default names another parameter) and which are
+    /// run-time parameters, indexed in declaration order.
+    pub(super) fn classify_parameters(&mut self, spec: &Spec) {
+        let declared: HashSet<String> = spec.params.iter().map(|p| p.name.to_string()).collect();
+        let mut index = 0;
+        for param in &spec.params {
+            let key = param.name.to_string();
+            if self.params.contains_key(&key) || self.derived.contains_key(&key) {
+                continue;
+            }
+            if names_any(&param.default, &declared) {
+                self.derived.insert(key, None);
+            } else {
+                self.params.insert(key, crate::expr::var_index(index));
+                index += 1;
+            }
+        }
+    }
+
     /// The run-time parameters with their defaults, and the derived ones lowered in declaration
     /// order (each may use run-time parameters and derived ones declared before it).
     pub(super) fn parameters(&mut self, spec: &Spec) -> (Vec<Param>, Vec<Derived>) {
@@ -97,5 +119,18 @@ impl Checker {
                 self.arena.zero()
             }
         }
+    }
+}
+
+/// Whether `e` names any of `names` (function names excluded).
+pub(super) fn names_any(e: &Expr, names: &HashSet<String>) -> bool {
+    match &e.kind {
+        ExprKind::Number(_) => false,
+        ExprKind::Name(name) => names.contains(&name.to_string()),
+        ExprKind::Neg(a) | ExprKind::Pow(a, _) => names_any(a, names),
+        ExprKind::Binary(_, a, b) | ExprKind::RealPow(a, b) => {
+            names_any(a, names) || names_any(b, names)
+        }
+        ExprKind::Call(_, args) | ExprKind::Tuple(args) => args.iter().any(|a| names_any(a, names)),
     }
 }
