@@ -95,7 +95,7 @@ fn read_into(source: &str, limits: &Limits, locations: &mut Locations) -> syn::R
             format!(
                 "the scene is {} bytes, more than the {} bytes mechgen reads (the limit is \
                  reached here); raise the limit to read it (`--max-file-size` on the command \
-                 line, `mechgen::syntax::limits::Limits` in code)",
+                 line, `mechgen::Limits` in code)",
                 source.len(),
                 limits.bytes
             ),
