@@ -20,8 +20,8 @@ const LEX_HINT: &str = "cannot split the file into tokens here: look for an unba
 /// Renders every error of `errors` (one block each) for the file `name` with contents `source`,
 /// followed by a one-line summary.
 ///
-/// The spans must come from reading `source` in this process with [`mechgen::syntax::source::read`],
-/// whose `locations` place them in the text.
+/// The spans must come from reading `source` in this process with
+/// [`mechgen::syntax::source::read`], whose `locations` place them in the text.
 pub fn render(name: &str, source: &str, locations: &Locations, errors: &mechgen::Errors) -> String {
     let mut out = String::new();
     let mut count = 0usize;

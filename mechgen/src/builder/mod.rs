@@ -2,11 +2,11 @@
 //! identical linkages), typically from a `build.rs` that writes the generated code into
 //! `OUT_DIR` for the crate to `include!`.
 //!
-//! [`SceneBuilder`] produces the spec *text* of [`crate::syntax::parse`]'s grammar, so a built scene goes
-//! through exactly the pipeline a hand-written one does and every check applies (unknown bodies,
-//! duplicate names, the Gruebler degree-of-freedom count, …). Names, numbers and expressions are
-//! checked early, as each statement is added; those errors and the checker's are returned
-//! together as [`Errors`].
+//! [`SceneBuilder`] produces the spec *text* of [`crate::syntax::parse`]'s grammar, so a built
+//! scene goes through exactly the pipeline a hand-written one does and every check applies
+//! (unknown bodies, duplicate names, the Gruebler degree-of-freedom count, …). Names, numbers
+//! and expressions are checked early, as each statement is added; those errors and the
+//! checker's are returned together as [`Errors`].
 //!
 //! ```
 //! use mechgen::builder::SceneBuilder;
@@ -35,6 +35,9 @@
 //! The line breaks matter (rustc is slow on very long lines); formatting with prettyplease (the
 //! `pretty` feature, `SceneBuilder::write_pretty_to`) adds nothing for rustc and costs more
 //! than the expansion itself on large scenes.
+//!
+//! This file is the builder's API; its arguments ([`Value`], [`Point`]) are in `values`, the
+//! token formatter ([`source_text`]) in `text`, and the file writing in `write`.
 
 mod text;
 mod values;
