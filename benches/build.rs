@@ -9,11 +9,15 @@ fn main() {
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples/scenes/piston_crank.mech");
     println!("cargo:rerun-if-changed={}", scene.display());
     let source = std::fs::read_to_string(&scene).expect("the seed scene is readable");
-    let options = mechgen::CodegenOptions {
-        naive: true,
+    let options = mechgen::Options {
+        codegen: mechgen::CodegenOptions {
+            naive: true,
+            ..Default::default()
+        },
         ..Default::default()
     };
-    let code = mechgen::expand_str_with(&source, &options).unwrap_or_else(|e| panic!("{e}"));
+    let code =
+        mechgen::expand(mechgen::Input::Text(&source), &options).unwrap_or_else(|e| panic!("{e}"));
     let out = PathBuf::from(std::env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     std::fs::write(out.join("piston_crank_naive.rs"), code.to_string())
         .expect("OUT_DIR is writable");

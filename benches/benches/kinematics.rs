@@ -106,7 +106,8 @@ fn time_steps<S: Clone>(
 fn scene(file: &str) -> mechgen::Scene {
     let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
     let source = std::fs::read_to_string(&path).expect("scene file");
-    mechgen::compile_str(&source).unwrap_or_else(|e| panic!("{path}: {e}"))
+    mechgen::compile(mechgen::Input::Text(&source), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
 fn interpreted(file: &str) -> Interpreted {

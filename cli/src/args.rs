@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use clap::{ArgGroup, Args, CommandFactory, Parser, Subcommand};
 
-use mechgen::limits::Limits;
+use mechgen::syntax::limits::Limits;
 
 use crate::solve::Format;
 

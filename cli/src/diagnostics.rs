@@ -3,7 +3,7 @@
 
 use core::fmt::Write;
 
-use mechgen::source::Locations;
+use mechgen::syntax::source::Locations;
 use proc_macro2::{LineColumn, Span};
 
 /// proc-macro2's lexer error carries no hint; this one says what usually causes it.
@@ -20,8 +20,8 @@ const LEX_HINT: &str = "cannot split the file into tokens here: look for an unba
 /// Renders every error of `errors` (one block each) for the file `name` with contents `source`,
 /// followed by a one-line summary.
 ///
-/// The spans must come from reading `source` in this process with [`mechgen::source::read`],
-/// whose `locations` place them in the text.
+/// The spans must come from reading `source` in this process with
+/// [`mechgen::syntax::source::read`], whose `locations` place them in the text.
 pub fn render(name: &str, source: &str, locations: &Locations, errors: &mechgen::Errors) -> String {
     let mut out = String::new();
     let mut count = 0usize;
@@ -165,9 +165,12 @@ mod tests {
     use super::*;
 
     fn rendered(source: &str) -> String {
-        let read = mechgen::source::read(source, &mechgen::limits::Limits::default());
+        let read =
+            mechgen::syntax::source::read(source, &mechgen::syntax::limits::Limits::default());
         let errors = match read.spec {
-            Ok(spec) => mechgen::compile_spec(&spec).err().expect("errors"),
+            Ok(spec) => mechgen::compile(mechgen::Input::Spec(&spec), &mechgen::Options::default())
+                .err()
+                .expect("errors"),
             Err(error) => error.into(),
         };
         render("scene.mech", source, &read.locations, &errors)

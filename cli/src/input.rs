@@ -3,7 +3,7 @@
 
 use std::io::{self, Read};
 
-use mechgen::limits::Limits;
+use mechgen::syntax::limits::Limits;
 
 use crate::args::Input;
 use crate::diagnostics;
@@ -59,16 +59,18 @@ fn too_large(name: &str, size: &str, limits: &Limits) -> Failure {
          takes about 2 s and 70 MB per 100 000 statements); scenes this \
          large are better built in code with `mechgen::builder`",
         limits.bytes,
-        mechgen::limits::MAX_SOURCE_BYTES
+        mechgen::syntax::limits::MAX_SOURCE_BYTES
     ))
 }
 
 /// Reads the scene's text within `limits` (statement by statement) and compiles it.
 pub(crate) fn compile(source: &Source, limits: &Limits) -> Result<mechgen::Scene, Failure> {
-    let read = mechgen::source::read(&source.text, limits);
+    let read = mechgen::syntax::source::read(&source.text, limits);
     read.spec
         .map_err(mechgen::Errors::from)
-        .and_then(|spec| mechgen::compile_spec(&spec))
+        .and_then(|spec| {
+            mechgen::compile(mechgen::Input::Spec(&spec), &mechgen::Options::default())
+        })
         .map_err(|errors| {
             Failure::Failed(diagnostics::render(
                 &source.name,

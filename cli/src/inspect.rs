@@ -7,7 +7,7 @@
 use core::fmt::{self, Write};
 
 use mechgen::Scene;
-use mechgen::interpret::Env;
+use mechgen::expr::tape::Env;
 use mechgen::model::{ConstraintKind, Model};
 use serde::Serialize;
 
@@ -118,7 +118,7 @@ pub fn summary(scene: &Scene, file: &str) -> Summary {
             .iter()
             .map(|d| Parameter {
                 name: d.name.to_string(),
-                default: mechgen::interpret::eval(&model.arena, d.value, &env) + 0.0,
+                default: mechgen::expr::tape::eval(&model.arena, d.value, &env) + 0.0,
             })
             .collect(),
         branches: model
@@ -154,7 +154,7 @@ fn length_scale(scene: &Scene, env: &Env) -> f64 {
     let dependent: Vec<f64> = scale
         .dependent
         .iter()
-        .map(|&id| mechgen::interpret::eval(&scene.model.arena, id, env))
+        .map(|&id| mechgen::expr::tape::eval(&scene.model.arena, id, env))
         .collect();
     scale.evaluate(&dependent)
 }
@@ -172,7 +172,7 @@ fn force_summary(model: &Model, env: &Env) -> ForceSummary {
         // `+ 0.0`: no `-0` in the report (a gravity `(0, -9810)` folds its x to −0).
         gravity: model
             .gravity
-            .map(|g| mechgen::interpret::eval(&model.arena, g, env) + 0.0),
+            .map(|g| mechgen::expr::tape::eval(&model.arena, g, env) + 0.0),
         loads: model.loads.iter().map(|l| l.name.clone()).collect(),
         reactions: model.reaction_names(),
     }
@@ -331,14 +331,14 @@ fn numbered(out: &mut String, names: &[String]) -> fmt::Result {
 
 fn write_stats(out: &mut String, scene: &Scene) -> fmt::Result {
     writeln!(out, "\nsolve structure:")?;
-    for line in mechgen::stats::structure(scene).lines() {
+    for line in mechgen::plan::stats::structure(scene).lines() {
         writeln!(out, "  {line}")?;
     }
     writeln!(
         out,
         "\noperation counts per generated function (each shared sub-expression once):"
     )?;
-    for line in mechgen::stats::table(scene).lines() {
+    for line in mechgen::plan::stats::table(scene).lines() {
         writeln!(out, "  {line}")?;
     }
     Ok(())
@@ -359,7 +359,8 @@ mod tests {
 
     #[test]
     fn reports_structure_and_counts() {
-        let scene = mechgen::compile_str(SCENE).expect("compiles");
+        let scene = mechgen::compile(mechgen::Input::Text(SCENE), &mechgen::Options::default())
+            .expect("compiles");
         let text = report(&scene, "p.mech", true);
         assert!(text.contains("coordinates (6):\n  0  frame.x\n"), "{text}");
         assert!(text.contains("equations (6):"), "{text}");
@@ -385,7 +386,7 @@ mod tests {
             "{text}"
         );
 
-        let counts = mechgen::stats::function_counts(&scene);
+        let counts = mechgen::plan::stats::function_counts(&scene);
         let names: Vec<_> = counts.iter().map(|f| f.function).collect();
         assert_eq!(
             names,
@@ -400,7 +401,8 @@ mod tests {
 
     #[test]
     fn json_holds_the_same_facts() {
-        let scene = mechgen::compile_str(SCENE).expect("compiles");
+        let scene = mechgen::compile(mechgen::Input::Text(SCENE), &mechgen::Options::default())
+            .expect("compiles");
         let value: serde_json::Value = serde_json::from_str(&json(&scene, "p.mech")).unwrap();
         assert_eq!(value["mechanism"], "Pendulum");
         assert_eq!(value["coordinates"][0], "frame.x");

@@ -4,7 +4,7 @@ use std::io::{self, Write};
 use std::process::ExitCode;
 
 /// mechgen's parser and checker recurse per nesting level and per operator of a chain. The
-/// input limits (`mechgen::limits`) bound that depth; this stack leaves a wide margin even
+/// input limits (`mechgen::syntax::limits`) bound that depth; this stack leaves a wide margin even
 /// for unoptimised builds, whose frames are large. Only touched pages are committed.
 const STACK_BYTES: usize = 256 << 20;
 

@@ -469,9 +469,12 @@ mod tests {
 
     #[test]
     fn overrides_name_the_declared_parameters() {
-        let scene = mechgen::compile_str(
-            "mechanism M { param w = 3; ground g at (0, 0, 0); body b near (0, 0, 0);
+        let scene = mechgen::compile(
+            mechgen::Input::Text(
+                "mechanism M { param w = 3; ground g at (0, 0, 0); body b near (0, 0, 0);
              joint j: revolute(g, b); driver d: angle(b) = w * t; }",
+            ),
+            &mechgen::Options::default(),
         )
         .expect("compiles");
         let mut mechanism = Interpreted::new(&scene);

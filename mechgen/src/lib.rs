@@ -1,161 +1,164 @@
 //! mechgen: compiles a declarative planar mechanism into specialised, allocation-free Rust.
 //!
-//! The pipeline runs one way, one module per stage:
+//! The pipeline runs one way, a folder per stage, over the shared tools ([`expr`]: the
+//! expression IR with its derivatives and evaluator; [`sparse`]: matching, components and the
+//! static LU):
 //!
 //! ```text
-//! tokens / .mech ─parse─▶ Spec ─check─▶ Model ─kinematics─▶ Φ, Φ_q, ν, γ (IR) ─structure─▶ Plan
-//!        (scenes that compute forces) ─dynamics─▶ F ─reactions─▶ reverse stages, reactions
-//!                                                  ─emit─▶ Rust tokens
-//!                                                  └─interpret─▶ numbers
+//! tokens / .mech ─syntax─▶ Spec ─check─▶ Model ─model::kinematics─▶ Φ, Φ_q, ν, γ ─plan::structure─▶ Plan
+//!   (scenes that compute forces) ─model::dynamics─▶ F ─plan::reactions─▶ reverse stages, reactions
+//!   Scene (model, kinematics, plan, forces) ─plan::kernels─▶ kernel list ─emit─▶ Rust tokens
+//!                                                                       └─(mechgen-interp)─▶ numbers
 //! ```
 //!
-//! [`expand`] is that pipeline; the `mechanism!` macro (crate `mechgen-macros`) is a thin
-//! adapter over it, and the `mechgen` CLI runs the same stages on `.mech` files. The grammar is
-//! documented in [`parse`].
+//! - [`syntax`]: the input limits, the bounded reader of `.mech` text, the grammar (documented
+//!   in [`syntax::parse`]) and the [`Spec`] it builds;
+//! - [`check`]: names resolved, values lowered to the IR, degrees of freedom counted, every
+//!   error at its span; its result is a [`Model`];
+//! - [`model`]: the checked model and what is derived from it: Φ and its derivatives, markers,
+//!   the generalised forces, the run-time rules on parameters;
+//! - [`plan`]: the solve planned once per scene (stages, blocks, the force solve, the kernel
+//!   list) into the [`Scene`] that both consumers read, and its operation counts;
+//! - [`emit`]: the scene as Rust tokens;
+//! - [`builder`]: scenes assembled in code and written for a `build.rs`.
+//!
+//! [`compile`] and [`expand`] are the front door: one input ([`Input`]: tokens, text or a
+//! parsed spec) and one set of [`Options`]. The `mechanism!` macro (crate `mechgen-macros`) is
+//! a thin adapter over [`expand_or_errors`], and the `mechgen` CLI runs the same stages on
+//! `.mech` files.
 #![deny(missing_docs)]
 
 pub mod builder;
 pub mod check;
-pub mod diff;
-pub mod dynamics;
 pub mod emit;
 pub mod error;
 pub mod expr;
-pub mod factor;
-mod frames;
-pub mod geometry;
-pub mod graph;
-pub mod interpret;
-pub mod kernels;
-pub mod kinematics;
-pub mod limits;
-pub mod markers;
 pub mod model;
-pub mod motion;
-pub mod parse;
-pub mod physics;
-pub mod reactions;
-pub mod resolution;
-pub mod source;
-pub mod spec;
-pub mod spline;
-pub mod stats;
-pub mod structure;
+pub mod plan;
+pub mod sparse;
+pub mod syntax;
 
 use proc_macro2::TokenStream;
 
 pub use emit::CodegenOptions;
 pub use error::Errors;
-pub use kinematics::Kinematics;
 pub use model::Model;
+pub use model::kinematics::Kinematics;
+pub use plan::Scene;
+pub use syntax::limits::Limits;
 
-/// A checked model with its derived kinematics and solve structure: everything needed to emit
-/// or interpret a scene.
-#[derive(Clone)]
-pub struct Scene {
-    /// The checked model; its arena also holds the derived expressions.
-    pub model: Model,
-    /// Φ, Φ_q, ν, γ and the initial guess.
-    pub kinematics: Kinematics,
-    /// The stages of the solve: explicit assignments and Newton blocks with their static LU.
-    pub plan: structure::Plan,
-    /// The force solve, for a scene that computes forces: the generalised forces, the plan's
-    /// stages in reverse, the reported reactions.
-    pub forces: Option<reactions::Forces>,
-    /// Every kernel of the plan and the force solve, as the emitter and the interpreter run them.
-    pub kernels: kernels::Kernels,
-    /// For a scene that computes forces, two values per load that name the load making F
-    /// non-finite (`dynamics::load_witnesses`); empty otherwise.
-    pub load_witnesses: Vec<expr::Id>,
+use model::{dynamics, kinematics};
+use plan::{kernels, reactions, structure};
+use syntax::spec::Spec;
+
+/// What [`compile`] and [`expand`] read.
+pub enum Input<'a> {
+    /// The body of a `mechanism!` invocation (or a whole `mechanism` declaration as tokens):
+    /// checked against the token limits only (nesting and statement length).
+    Tokens(TokenStream),
+    /// The contents of a `.mech` file, read within [`Options::limits`].
+    Text(&'a str),
+    /// A spec already parsed, for instance read with [`syntax::source::read`] so that the
+    /// errors' spans can be placed in the text.
+    Spec(&'a Spec),
 }
 
-/// Parses, checks and differentiates a spec given as tokens.
+/// How [`compile`] and [`expand`] read the input and shape the generated code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Options {
+    /// The size and count limits on [`Input::Text`] (nesting and statement length always
+    /// apply). Text a program wrote, such as [`builder`]'s, is read with
+    /// [`Limits::UNBOUNDED_SIZE`].
+    pub limits: Limits,
+    /// The shape of the generated code; its `naive` flag also compiles the scene into an
+    /// unsimplified arena.
+    pub codegen: CodegenOptions,
+}
+
+/// Reads, checks, differentiates and plans a scene: everything needed to emit or interpret
+/// it.
 ///
 /// # Errors
-/// A syntax error, or every semantic error found, each at its span.
-pub fn compile(tokens: TokenStream) -> Result<Scene, Errors> {
-    let spec = parse::parse_tokens(tokens)?;
-    scene(&spec)
-}
-
-/// Parses, checks and differentiates a spec given as text (the contents of a `.mech` file).
-///
-/// # Errors
-/// As [`compile`].
-pub fn compile_str(source: &str) -> Result<Scene, Errors> {
-    let spec = source::parse_str(source)?;
-    scene(&spec)
-}
-
-/// Checks and differentiates a parsed spec (read from text with [`source::read`], whose
-/// locations place the errors' spans in the text).
-///
-/// # Errors
-/// Every semantic error found, each at its span.
-pub fn compile_spec(spec: &spec::Spec) -> Result<Scene, Errors> {
-    scene(spec)
-}
-
-fn scene(spec: &spec::Spec) -> Result<Scene, Errors> {
-    let model = check::check(spec)?;
-    Ok(Scene::derive(model))
-}
-
-impl Scene {
-    /// The stages after `check`: kinematics, the solve structure, and for a scene that
-    /// computes forces its dynamics and the force solve's structure.
-    fn derive(mut model: Model) -> Self {
-        let kinematics = kinematics::derive(&mut model);
-        let mut plan = structure::plan(&mut model, &kinematics);
-        let forces = (model.outputs >= model::Outputs::Forces).then(|| {
-            let generalized = dynamics::derive(&mut model);
-            let forces = reactions::plan(&mut model, &kinematics, &plan, generalized);
-            let reads: Vec<expr::Id> = kinematics
-                .markers
-                .iter()
-                .chain(forces.kernel_roots())
-                .copied()
-                .collect();
-            let n = model.dim();
-            plan.cache_final_reads(&mut model.arena, n, &reads);
-            forces
-        });
-        let kernels = kernels::list(
-            &model.arena,
-            &plan,
-            forces.as_ref(),
-            &kinematics.markers,
-            &kinematics.branches,
-        );
-        let load_witnesses = match forces {
-            Some(_) => dynamics::load_witnesses(&mut model),
-            None => Vec::new(),
-        };
-        Scene {
-            model,
-            kinematics,
-            plan,
-            forces,
-            kernels,
-            load_witnesses,
+/// A limit exceeded or a syntax error, at its position; or every semantic error found, each
+/// at its span.
+pub fn compile(input: Input<'_>, options: &Options) -> Result<Scene, Errors> {
+    let parsed;
+    let spec = match input {
+        Input::Tokens(tokens) => {
+            parsed = syntax::parse::parse_tokens(tokens)?;
+            &parsed
         }
+        Input::Text(text) => {
+            parsed = syntax::source::read(text, &options.limits).spec?;
+            &parsed
+        }
+        Input::Spec(spec) => spec,
+    };
+    let arena = if options.codegen.naive {
+        expr::Arena::unsimplified()
+    } else {
+        expr::Arena::new()
+    };
+    let model = check::check_into(spec, arena)?;
+    Ok(scene(model))
+}
+
+/// The stages after `check`: kinematics, the solve structure, and for a scene that computes
+/// forces its dynamics and the force solve's structure.
+fn scene(mut model: Model) -> Scene {
+    let kinematics = kinematics::derive(&mut model);
+    let mut plan = structure::plan(&mut model, &kinematics);
+    let forces = (model.outputs >= model::Outputs::Forces).then(|| {
+        let generalized = dynamics::derive(&mut model);
+        let forces = reactions::plan(&mut model, &kinematics, &plan, generalized);
+        let reads: Vec<expr::Id> = kinematics
+            .markers
+            .iter()
+            .chain(forces.kernel_roots())
+            .copied()
+            .collect();
+        let n = model.dim();
+        plan.cache_final_reads(&mut model.arena, n, &reads);
+        forces
+    });
+    let kernels = kernels::list(
+        &model.arena,
+        &plan,
+        forces.as_ref(),
+        &kinematics.markers,
+        &kinematics.branches,
+    );
+    let load_witnesses = match forces {
+        Some(_) => dynamics::load_witnesses(&mut model),
+        None => Vec::new(),
+    };
+    Scene {
+        model,
+        kinematics,
+        plan,
+        forces,
+        kernels,
+        load_witnesses,
     }
 }
 
-/// The whole pipeline: spec tokens to generated Rust tokens.
+/// The whole pipeline: [`compile`], then [`emit`] with [`Options::codegen`]. What a `build.rs`
+/// writes into `OUT_DIR` (see [`builder`] for assembling large scenes in code); `pretty`
+/// (feature `pretty`) formats it for reading.
 ///
 /// # Errors
 /// As [`compile`].
-pub fn expand(tokens: TokenStream) -> Result<TokenStream, Errors> {
-    let scene = compile(tokens)?;
-    Ok(emit::emit(&scene))
+pub fn expand(input: Input<'_>, options: &Options) -> Result<TokenStream, Errors> {
+    let scene = compile(input, options)?;
+    Ok(emit::emit_with(&scene, &options.codegen))
 }
 
 /// [`expand`] for the proc macro: errors become `compile_error!`s at their spans, and a panic in
 /// the generator (a bug) is reported as an internal error instead of crashing rustc's macro
 /// expansion.
 pub fn expand_or_errors(tokens: TokenStream) -> TokenStream {
-    let result = std::panic::catch_unwind(move || expand(tokens));
+    let result =
+        std::panic::catch_unwind(move || expand(Input::Tokens(tokens), &Options::default()));
     match result {
         Ok(Ok(code)) => code,
         Ok(Err(errors)) => errors.to_compile_errors(),
@@ -165,48 +168,6 @@ pub fn expand_or_errors(tokens: TokenStream) -> TokenStream {
         )
         .to_compile_error(),
     }
-}
-
-/// Parses, checks and differentiates a `.mech` source for emission with `options` (the naive
-/// baseline compiles into an unsimplified arena). The text is read without the size and count
-/// limits (nesting and statement length still apply): this is the path for scenes a program
-/// writes, such as `builder`'s.
-///
-/// # Errors
-/// As [`compile_str`].
-pub fn compile_str_with(source: &str, options: &emit::CodegenOptions) -> Result<Scene, Errors> {
-    // Text a program wrote (`builder`, a build script): size and count are the caller's call.
-    let spec = source::read(source, &limits::Limits::UNBOUNDED_SIZE).spec?;
-    let arena = if options.naive {
-        expr::Arena::unsimplified()
-    } else {
-        expr::Arena::new()
-    };
-    let model = check::check_into(&spec, arena)?;
-    Ok(Scene::derive(model))
-}
-
-/// Generated code for a `.mech` source with explicit options, as tokens: what a `build.rs`
-/// writes into `OUT_DIR` (see the `builder` module for assembling large scenes in code).
-///
-/// # Errors
-/// As [`compile_str`].
-pub fn expand_str_with(
-    source: &str,
-    options: &emit::CodegenOptions,
-) -> Result<TokenStream, Errors> {
-    let scene = compile_str_with(source, options)?;
-    Ok(emit::emit_with(&scene, options))
-}
-
-/// Generated code for a `.mech` source, formatted for reading (CLI `expand`, snapshots).
-///
-/// # Errors
-/// As [`compile_str`].
-#[cfg(feature = "pretty")]
-pub fn expand_pretty(source: &str) -> Result<String, Errors> {
-    let scene = compile_str(source)?;
-    Ok(pretty(emit::emit(&scene)))
 }
 
 /// Formats generated tokens with prettyplease.
@@ -237,7 +198,7 @@ mod tests {
             }";
         let expand = || {
             let tokens: proc_macro2::TokenStream = source.parse().expect("lexes");
-            super::expand(tokens)
+            super::expand(super::Input::Tokens(tokens), &super::Options::default())
                 .unwrap_or_else(|e| panic!("{e}"))
                 .to_string()
         };

@@ -249,7 +249,7 @@ fn budget(m: &Interpreted, solves: usize) -> u64 {
 /// When the scene breaks an invariant (module docs): an `Ok` state whose constraints do not
 /// hold, or more evaluations than the solver's caps allow.
 pub fn run(source: &str, tally: &mut Tally) {
-    let scene = match mechgen::compile_str(source) {
+    let scene = match mechgen::compile(mechgen::Input::Text(source), &mechgen::Options::default()) {
         Ok(scene) => scene,
         Err(_) => {
             tally.compile_errors += 1;

@@ -133,7 +133,9 @@ where
 }
 
 fn interpreted(source: &str) -> Interpreted {
-    Interpreted::new(&mechgen::compile_str(source).unwrap())
+    Interpreted::new(
+        &mechgen::compile(mechgen::Input::Text(source), &mechgen::Options::default()).unwrap(),
+    )
 }
 
 /// Every magnitude from 1 to 1e20 rad, each solved by `solve_with` (one of the three solvers):

@@ -62,7 +62,14 @@ fn the_seed_built_in_code_generates_the_same_code_as_its_file() {
         "/../examples/scenes/piston_crank.mech"
     );
     let file = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let from_file = mechgen::expand_str_with(&file, &options).unwrap_or_else(|e| panic!("{e}"));
+    let from_file = mechgen::expand(
+        mechgen::Input::Text(&file),
+        &mechgen::Options {
+            codegen: options,
+            ..Default::default()
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(built.to_string(), from_file.to_string());
 }
 
@@ -72,7 +79,8 @@ fn scissor_lifts_of_several_sizes_rise_as_n_l_sin_alpha() {
         let text = scene::scissor_lift(stages)
             .build()
             .unwrap_or_else(|e| panic!("{e}"));
-        let compiled = mechgen::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let compiled = mechgen::compile(mechgen::Input::Text(&text), &mechgen::Options::default())
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
         let lift = Interpreted::new(&compiled);
         assert_eq!(lift.len(), 6 * stages + geometry::EXTRA_COORDINATES);
         let platform = 2 * stages + 2;

@@ -266,7 +266,11 @@ fn a_start_at_three_seconds_is_not_the_mirror() {
     // `--at 3` gave the mirror angle −0.6426; the motion from t = 0 reaches 2.4990.
     let expected = lever_angle(3.0);
     assert!((expected - 2.4990).abs() < 1e-4, "{expected}");
-    let scene = mechgen::compile_str(MIRROR_AT_START).unwrap();
+    let scene = mechgen::compile(
+        mechgen::Input::Text(MIRROR_AT_START),
+        &mechgen::Options::default(),
+    )
+    .unwrap();
     let interpreted = mechgen_interp::Interpreted::new(&scene);
     let simulation = Simulation::new(Solver::new(interpreted), 3.0).unwrap();
     let theta = simulation.state().q[MirrorAtStart::LEVER_THETA];

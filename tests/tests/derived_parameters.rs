@@ -118,7 +118,8 @@ fn derived_parameters_move_as_the_written_out_scene_and_follow_their_parameters(
 
 #[test]
 fn the_interpreter_substitutes_them_too() {
-    let scene = mechgen::compile_str(DERIVED).unwrap_or_else(|e| panic!("{e}"));
+    let scene = mechgen::compile(mechgen::Input::Text(DERIVED), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{e}"));
     let mut interpreted = Interpreted::new(&scene);
     interpreted
         .set_parameter("a", 22.0)
@@ -144,11 +145,19 @@ fn the_interpreter_substitutes_them_too() {
     let generated_q: Vec<f64> = by_generated.step_to(t).unwrap().q.iter().copied().collect();
     assert_close(&[interpreted_q], &[generated_q]);
     // The written-out twin's text compiles too (it is the reference above).
-    assert!(mechgen::compile_str(WRITTEN_OUT).is_ok());
+    assert!(
+        mechgen::compile(
+            mechgen::Input::Text(WRITTEN_OUT),
+            &mechgen::Options::default()
+        )
+        .is_ok()
+    );
 }
 
 #[test]
 fn generated_code_snapshot() {
-    let code = mechgen::expand_pretty(DERIVED).unwrap_or_else(|e| panic!("{e}"));
+    let code = mechgen::expand(mechgen::Input::Text(DERIVED), &mechgen::Options::default())
+        .map(mechgen::pretty)
+        .unwrap_or_else(|e| panic!("{e}"));
     insta::assert_snapshot!("derived_parameters", code);
 }

@@ -136,7 +136,10 @@ const NAMED: &str = "mechanism Named {
 }";
 
 fn interpreted(source: &str) -> Interpreted {
-    Interpreted::new(&mechgen::compile_str(source).unwrap_or_else(|e| panic!("{e}")))
+    Interpreted::new(
+        &mechgen::compile(mechgen::Input::Text(source), &mechgen::Options::default())
+            .unwrap_or_else(|e| panic!("{e}")),
+    )
 }
 
 /// Display and Debug both hold every one of `names` and no bare index (`#3`); Debug leads with

@@ -35,7 +35,8 @@ const BALANCE: f64 = 1e-11;
 const AGREEMENT: f64 = 1e-10;
 
 fn compile(text: &str) -> mechgen::Scene {
-    mechgen::compile_str(text).unwrap_or_else(|e| panic!("{e}"))
+    mechgen::compile(mechgen::Input::Text(text), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// The positions along the scene's motion from t = 0, followed in `GRID` steps (the

@@ -182,7 +182,8 @@ where
 
 /// Steps a `.mech` scene with the interpreter and checks Newton–Euler at every state.
 fn assert_newton_euler(source: &str, t_end: f64, steps: usize) {
-    let scene = mechgen::compile_str(source).unwrap_or_else(|e| panic!("{e}"));
+    let scene = mechgen::compile(mechgen::Input::Text(source), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{e}"));
     let worst = newton_euler_along(&scene, Interpreted::new(&scene), t_end, steps);
     assert!(worst <= 1e-10, "Newton–Euler residual {worst:e}");
 }
@@ -198,7 +199,8 @@ fn assert_newton_euler_both<S: Scene + Structured + Forces>(steps: usize)
 where
     mechgen_runtime::nalgebra::DefaultAllocator: mechgen_runtime::Storage<S::Dim>,
 {
-    let scene = mechgen::compile_str(S::TEXT).unwrap_or_else(|e| panic!("{e}"));
+    let scene = mechgen::compile(mechgen::Input::Text(S::TEXT), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{e}"));
     let name = scene.model.name.to_string();
     let worst = newton_euler_along(&scene, S::default(), S::T_END, steps);
     assert!(
@@ -242,7 +244,10 @@ fn generated_force_solve_matches_the_interpreter_across_blocks() {
     // Carriage solves in two blocks, so its force solve walks the archive of the first
     // block's factors; Sink has every joint kind.
     let interpreted = |text: &str| {
-        Interpreted::new(&mechgen::compile_str(text).unwrap_or_else(|e| panic!("{e}")))
+        Interpreted::new(
+            &mechgen::compile(mechgen::Input::Text(text), &mechgen::Options::default())
+                .unwrap_or_else(|e| panic!("{e}")),
+        )
     };
     let error = relative_error(
         &reaction_rows(Sink::default(), 2.0, 60),
@@ -452,7 +457,10 @@ fn non_finite_loads_are_typed_errors_naming_the_forces() {
                 {load}
             }}"
         );
-        Interpreted::new(&mechgen::compile_str(&source).unwrap_or_else(|e| panic!("{e}")))
+        Interpreted::new(
+            &mechgen::compile(mechgen::Input::Text(&source), &mechgen::Options::default())
+                .unwrap_or_else(|e| panic!("{e}")),
+        )
     };
     for (load, time, named) in [
         (
@@ -489,7 +497,8 @@ fn a_zero_length_spring_stays_finite_where_its_ends_meet() {
         load coil: spring(frame, slider, stiffness 3, length 0);
     }";
     let mut solver = Solver::new(Interpreted::new(
-        &mechgen::compile_str(source).unwrap_or_else(|e| panic!("{e}")),
+        &mechgen::compile(mechgen::Input::Text(source), &mechgen::Options::default())
+            .unwrap_or_else(|e| panic!("{e}")),
     ));
     for time in [0.5, 1.0, 1.5] {
         let guess = DVector::from_vec(vec![0.0, 0.0, 0.0, 1.0 - time, 0.0, 0.0]);
@@ -518,7 +527,8 @@ fn force_kernels_read_their_angles_from_the_trig_cache() {
         driver spin: angle(crank) = 3 * t;
         load push: force(crank @ (1, 0)) = (0, 2);
     }";
-    let scene = mechgen::compile_str(source).unwrap_or_else(|e| panic!("{e}"));
+    let scene = mechgen::compile(mechgen::Input::Text(source), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{e}"));
     let code = mechgen::emit::emit(&scene).to_string();
     let mut kernels = 0;
     // Every function body sits between `fn name (` and the next `fn `.

@@ -11,7 +11,7 @@ fn scene_source(file: &str) -> String {
 
 fn expanded(file: &str) -> String {
     let tokens: proc_macro2::TokenStream = scene_source(file).parse().expect("lexes");
-    mechgen::expand(tokens)
+    mechgen::expand(mechgen::Input::Tokens(tokens), &mechgen::Options::default())
         .unwrap_or_else(|e| panic!("{file}: {e}"))
         .to_string()
 }
@@ -107,7 +107,8 @@ fn masses_without_the_forces_output_generate_no_force_code() {
         "gravity (0, -9810);\n    outputs positions, velocities, accelerations;",
     );
     let tokens: proc_macro2::TokenStream = source.parse().expect("lexes");
-    let code = mechgen::expand(tokens).unwrap_or_else(|e| panic!("{e}"));
+    let code = mechgen::expand(mechgen::Input::Tokens(tokens), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{e}"));
     let words = words(&code.to_string());
     for absent in FORCE_ITEMS {
         assert!(!words.iter().any(|w| w == absent), "`{absent}` generated");
@@ -162,7 +163,11 @@ fn each_angle_has_at_most_one_sin_and_cos_per_function() {
 #[test]
 fn no_identically_zero_jacobian_entry_is_stored() {
     for file in ["piston_crank.mech", "four_bar.mech", "offset_slider.mech"] {
-        let scene = mechgen::compile_str(&scene_source(file)).unwrap_or_else(|e| panic!("{e}"));
+        let scene = mechgen::compile(
+            mechgen::Input::Text(&scene_source(file)),
+            &mechgen::Options::default(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
         for entry in &scene.kinematics.jacobian {
             assert!(
                 !scene.model.arena.is_zero(entry.value),

@@ -53,8 +53,15 @@ pub mechanism Seed {
 
 #[test]
 fn named_points_generate_the_written_out_scene() {
-    let named = mechgen::expand_pretty(NAMED).unwrap_or_else(|e| panic!("{e}"));
-    let written = mechgen::expand_pretty(WRITTEN_OUT).unwrap_or_else(|e| panic!("{e}"));
+    let named = mechgen::expand(mechgen::Input::Text(NAMED), &mechgen::Options::default())
+        .map(mechgen::pretty)
+        .unwrap_or_else(|e| panic!("{e}"));
+    let written = mechgen::expand(
+        mechgen::Input::Text(WRITTEN_OUT),
+        &mechgen::Options::default(),
+    )
+    .map(mechgen::pretty)
+    .unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(named, written);
     insta::assert_snapshot!("named_points", named);
 }
@@ -86,7 +93,7 @@ fn misused_points_are_reported_at_their_use() {
             &format!("{extra} driver crank_angle"),
             1,
         );
-        match mechgen::compile_str(&source) {
+        match mechgen::compile(mechgen::Input::Text(&source), &mechgen::Options::default()) {
             Ok(_) => panic!("expected an error for {extra}"),
             Err(e) => e.to_string(),
         }

@@ -154,7 +154,8 @@ fn generated_code_checks_physics_set_at_run_time() {
 
 #[test]
 fn the_interpreter_checks_physics_set_at_run_time() {
-    let scene = mechgen::compile_str(LOADED).unwrap();
+    let scene =
+        mechgen::compile(mechgen::Input::Text(LOADED), &mechgen::Options::default()).unwrap();
     refuses_bad_physics(|p, v| solve_with(Interpreted::new(&scene), p, v));
 }
 
@@ -169,7 +170,9 @@ fn constant_physics_generates_no_check() {
         .replace("ratio ratio", "ratio 2");
     for (source, generated) in [(LOADED, true), (constant.as_str(), false)] {
         let tokens: proc_macro2::TokenStream = source.parse().unwrap();
-        let code = mechgen::expand(tokens).unwrap().to_string();
+        let code = mechgen::expand(mechgen::Input::Tokens(tokens), &mechgen::Options::default())
+            .unwrap()
+            .to_string();
         assert_eq!(
             code.contains("check_physics"),
             generated,

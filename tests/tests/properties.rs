@@ -42,7 +42,8 @@ twin! {
 fn interpreted(file: &str) -> Interpreted {
     let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
     let source = std::fs::read_to_string(&path).expect("scene file");
-    let scene = mechgen::compile_str(&source).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let scene = mechgen::compile(mechgen::Input::Text(&source), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{path}: {e}"));
     Interpreted::new(&scene)
 }
 
@@ -293,7 +294,7 @@ proptest! {
 
     #[test]
     fn library_generated_and_interpreted_agree((q, qd, t) in library_states()) {
-        let scene = mechgen::compile_str(LIBRARY).unwrap_or_else(|e| panic!("{e}"));
+        let scene = mechgen::compile(mechgen::Input::Text(LIBRARY), &mechgen::Options::default()).unwrap_or_else(|e| panic!("{e}"));
         agree(&Library::default(), &Interpreted::new(&scene), &q, &qd, t)?;
     }
 

@@ -8,7 +8,7 @@ use mechgen_runtime::{Mechanism, Simulation, SolveError, Solver, Vector, nalgebr
 const SEED: &str = include_str!("../../examples/scenes/piston_crank.mech");
 
 fn interpreted(source: &str) -> Result<Interpreted, String> {
-    mechgen::compile_str(source)
+    mechgen::compile(mechgen::Input::Text(source), &mechgen::Options::default())
         .map(|scene| Interpreted::new(&scene))
         .map_err(|errors| errors.messages().join("\n"))
 }

@@ -49,7 +49,8 @@ fn with_scene_settings(path: &Path, check: impl FnOnce()) {
 fn generated_code() {
     for path in scenes() {
         let source = fs::read_to_string(&path).expect("readable scene");
-        let code = mechgen::expand_pretty(&source)
+        let code = mechgen::expand(mechgen::Input::Text(&source), &mechgen::Options::default())
+            .map(mechgen::pretty)
             .unwrap_or_else(|e| panic!("{} does not compile:\n{e}", path.display()));
         with_scene_settings(&path, || insta::assert_snapshot!(stem(&path), code));
     }
@@ -69,12 +70,15 @@ fn operation_counts() {
 /// The Jacobian's sparsity and the operation table of every generated function, lean (what
 /// users get) and naive (no folding, no simplification, no sharing: the baseline it saves on).
 fn operation_table(source: &str) -> Result<String, mechgen::Errors> {
-    let lean = mechgen::compile_str(source)?;
-    let naive_options = mechgen::CodegenOptions {
-        naive: true,
+    let lean = mechgen::compile(mechgen::Input::Text(source), &mechgen::Options::default())?;
+    let naive_options = mechgen::Options {
+        codegen: mechgen::CodegenOptions {
+            naive: true,
+            ..Default::default()
+        },
         ..Default::default()
     };
-    let naive = mechgen::compile_str_with(source, &naive_options)?;
+    let naive = mechgen::compile(mechgen::Input::Text(source), &naive_options)?;
     let n = lean.model.dim();
     let mut table = format!(
         "{n} coordinates; Jacobian: {} structural non-zeros of {} (naive: {})\n\n",
@@ -83,9 +87,9 @@ fn operation_table(source: &str) -> Result<String, mechgen::Errors> {
         naive.kinematics.jacobian.len()
     );
     table += "lean (folded, simplified, shared sub-expressions):\n";
-    table += &mechgen::stats::table(&lean);
+    table += &mechgen::plan::stats::table(&lean);
     table += "\nnaive (no folding or simplification, every use evaluated):\n";
-    table += &mechgen::stats::table(&naive);
+    table += &mechgen::plan::stats::table(&naive);
     Ok(table)
 }
 
@@ -93,9 +97,9 @@ fn operation_table(source: &str) -> Result<String, mechgen::Errors> {
 fn solve_structure() {
     for path in scenes() {
         let source = fs::read_to_string(&path).expect("readable scene");
-        let scene = mechgen::compile_str(&source)
+        let scene = mechgen::compile(mechgen::Input::Text(&source), &mechgen::Options::default())
             .unwrap_or_else(|e| panic!("{} does not compile:\n{e}", path.display()));
-        let structure = mechgen::stats::structure(&scene);
+        let structure = mechgen::plan::stats::structure(&scene);
         with_scene_settings(&path, || {
             insta::assert_snapshot!(format!("{}_structure", stem(&path)), structure);
         });

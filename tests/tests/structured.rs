@@ -287,7 +287,8 @@ fn a_singular_block_names_the_coordinates_downstream() {
 fn interpreted(file: &str) -> Interpreted {
     let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
     let source = std::fs::read_to_string(&path).expect("scene file");
-    let scene = mechgen::compile_str(&source).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let scene = mechgen::compile(mechgen::Input::Text(&source), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{path}: {e}"));
     Interpreted::new(&scene)
 }
 

@@ -11,7 +11,10 @@ use mechgen_runtime::{Mechanism, Simulation, Solver, Structured, Unit, Vector};
 fn interpreted(file: &str) -> Interpreted {
     let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
     let source = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    Interpreted::new(&mechgen::compile_str(&source).unwrap_or_else(|e| panic!("{e}")))
+    Interpreted::new(
+        &mechgen::compile(mechgen::Input::Text(&source), &mechgen::Options::default())
+            .unwrap_or_else(|e| panic!("{e}")),
+    )
 }
 
 /// Units, length scale and branch names agree, past the ends too.

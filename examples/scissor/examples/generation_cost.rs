@@ -1,5 +1,5 @@
 //! How generation cost grows with scene size: for the scissor lift at n stages, the time to
-//! build the spec text, expand it (`mechgen::expand_str_with`), turn the tokens into source text
+//! build the spec text, expand it (`mechgen::expand`), turn the tokens into source text
 //! as `write_to_out_dir` does (and optionally format them with prettyplease, for comparison), and the release compile time of the generated code in a scratch
 //! crate.
 //!
@@ -125,7 +125,13 @@ fn main() -> Result<(), Box<dyn Error>> {
         let build = start.elapsed();
 
         let start = Instant::now();
-        let tokens = mechgen::expand_str_with(&spec, &options.codegen)?;
+        let tokens = mechgen::expand(
+            mechgen::Input::Text(&spec),
+            &mechgen::Options {
+                limits: mechgen::Limits::UNBOUNDED_SIZE,
+                codegen: options.codegen,
+            },
+        )?;
         let expand = start.elapsed();
 
         // What `write_to_out_dir` writes: one statement per line (see `source_text`).

@@ -58,7 +58,8 @@ impl ForceReport {
 pub fn run(plan: &Plan) -> Result<ForceReport, ReportError> {
     let setting = plan.reference;
     let source = include_str!("../../scenes/piston_crank_dynamics.mech");
-    let scene = mechgen::compile_str(source).map_err(|e| ReportError::Scene(e.to_string()))?;
+    let scene = mechgen::compile(mechgen::Input::Text(source), &mechgen::Options::default())
+        .map_err(|e| ReportError::Scene(e.to_string()))?;
     let scenes = (
         PistonCrankDynamics::default(),
         Dense::new(PistonCrankDynamics::default()),

@@ -19,8 +19,8 @@
 use std::cell::RefCell;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
+use mechgen::expr::tape::{Inputs, Scalar, Tape};
 use mechgen::expr::{Func, Func2};
-use mechgen::interpret::{Inputs, Scalar, Tape};
 use mechgen_runtime::nalgebra::{DefaultAllocator, Dim, U1};
 use mechgen_runtime::{
     Accelerations, Matrix, Mechanism, Outputs, ParameterError, Storage, Unit, Vector, Velocities,
@@ -718,7 +718,11 @@ mod tests {
     use mechgen_runtime::nalgebra::Const;
 
     fn seed_scene() -> mechgen::Scene {
-        mechgen::compile_str(include_str!("../../scenes/piston_crank.mech")).expect("compiles")
+        mechgen::compile(
+            mechgen::Input::Text(include_str!("../../scenes/piston_crank.mech")),
+            &mechgen::Options::default(),
+        )
+        .expect("compiles")
     }
 
     /// Largest |a − b| relative to max(1, |b|) over all entries.
@@ -765,8 +769,11 @@ mod tests {
 
     #[test]
     fn autodiff_rejects_a_different_scene_and_tracks_parameters() {
-        let four_bar =
-            mechgen::compile_str(include_str!("../../scenes/four_bar.mech")).expect("compiles");
+        let four_bar = mechgen::compile(
+            mechgen::Input::Text(include_str!("../../scenes/four_bar.mech")),
+            &mechgen::Options::default(),
+        )
+        .expect("compiles");
         assert!(matches!(
             AutoDiff::new(PistonCrank::default(), &four_bar),
             Err(MethodError::Mismatch(_))

@@ -435,7 +435,11 @@ fn run_case<M, const N: usize>(
 where
     M: Structured<Dim = Const<N>> + Accelerations + Clone,
 {
-    let scene = mechgen::compile_str(case.source).map_err(|e| ReportError::Scene(e.to_string()))?;
+    let scene = mechgen::compile(
+        mechgen::Input::Text(case.source),
+        &mechgen::Options::default(),
+    )
+    .map_err(|e| ReportError::Scene(e.to_string()))?;
     let methods = Methods {
         generated: case.mechanism.clone(),
         dense: Dense::new(case.mechanism.clone()),

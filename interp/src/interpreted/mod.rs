@@ -13,10 +13,10 @@ mod textbook;
 use std::cell::{Cell, RefCell};
 
 use mechgen::Scene;
-use mechgen::geometry;
-use mechgen::interpret::{Inputs, Tape};
-use mechgen::kinematics::LengthScale;
-use mechgen::physics;
+use mechgen::expr::tape::{Inputs, Tape};
+use mechgen::model::geometry;
+use mechgen::model::kinematics::LengthScale;
+use mechgen::model::physics;
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{Matrix, Names, Outputs, Unit};
 

@@ -1,9 +1,9 @@
-//! The plan of an interpreted scene: its kernel list (`mechgen::kernels`) compiled into tapes,
+//! The plan of an interpreted scene: its kernel list (`mechgen::plan::kernels`) compiled into tapes,
 //! behind the runtime's `Structured` trait. Where generated code has a `match` on the stage,
 //! a method here looks the stage's kernel up in a table.
 
-use mechgen::interpret::{Inputs, Tape};
-use mechgen::kernels::{self, Buffer, Method};
+use mechgen::expr::tape::{Inputs, Tape};
+use mechgen::plan::kernels::{self, Buffer, Method};
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{Block, Pattern, Stage, Structured, VecBuffers, Vector};
 
@@ -25,7 +25,7 @@ impl Compiled {
     }
 }
 
-/// The scene's kernel list (`mechgen::kernels`) compiled: the `Structured` methods look up
+/// The scene's kernel list (`mechgen::plan::kernels`) compiled: the `Structured` methods look up
 /// the kernel of a stage and method in a table, where generated code has a `match`.
 #[derive(Debug, Clone)]
 pub(super) struct PlanTapes {

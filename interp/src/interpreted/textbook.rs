@@ -2,8 +2,8 @@
 //! the parameter checks) as tapes, behind the runtime's `Mechanism` trait.
 
 use mechgen::Scene;
-use mechgen::interpret::Tape;
-use mechgen::{geometry, physics};
+use mechgen::expr::tape::Tape;
+use mechgen::model::{geometry, physics};
 use mechgen_runtime::first_load_fault;
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{
@@ -12,7 +12,7 @@ use mechgen_runtime::{
 };
 
 use super::Interpreted;
-use mechgen::interpret::Inputs;
+use mechgen::expr::tape::Inputs;
 
 /// The scene's functions of the whole state, one tape each.
 #[derive(Debug, Clone)]

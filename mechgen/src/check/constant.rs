@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use super::{Checker, Lengths};
 use crate::error::Errors;
 use crate::expr::{Arena, Node};
-use crate::spec::{Expr, ExprKind};
+use crate::syntax::spec::{Expr, ExprKind};
 
 /// The value of `text`, a constant expression: numbers, `pi`, degrees (`30deg`), `+ - * / ^`
 /// and the scene grammar's functions (`sqrt(2)`, `atan2(1, 2)`).
@@ -45,7 +45,7 @@ pub fn constant_value(text: &str) -> Result<f64, String> {
     let constant = !cx
         .arena
         .any_node(id, |n| matches!(n, Node::Var(_) | Node::Param(_)));
-    let value = crate::interpret::eval(&cx.arena, id, &crate::interpret::Env::default());
+    let value = crate::expr::tape::eval(&cx.arena, id, &crate::expr::tape::Env::default());
     if constant && value.is_finite() {
         // No negative zero in what is written back.
         Ok(value + 0.0)

@@ -10,7 +10,7 @@ use syn::Ident;
 use super::Checker;
 use crate::expr::Id;
 use crate::model::{Load, LoadKind, MassProperties, Outputs, Point};
-use crate::spec::{BodyDecl, Expr, LoadDecl, PointRef, Spec};
+use crate::syntax::spec::{BodyDecl, Expr, LoadDecl, PointRef, Spec};
 
 /// Names of the accessors generated for a scene that computes forces (`state.reactions()`,
 /// `state.efforts()`), which a body's accessor of the same name would make ambiguous.
@@ -71,7 +71,7 @@ impl Checker {
     /// A load: forces and torques on moving bodies, springs between two bodies not both fixed.
     pub(super) fn load(&mut self, decl: &LoadDecl) -> Option<Load> {
         let kind = match &decl.kind {
-            crate::spec::LoadKind::Force {
+            crate::syntax::spec::LoadKind::Force {
                 point,
                 value,
                 local,
@@ -84,12 +84,12 @@ impl Checker {
                     local: *local,
                 }
             }
-            crate::spec::LoadKind::Torque { body, value } => {
+            crate::syntax::spec::LoadKind::Torque { body, value } => {
                 let value = self.lower(value, true);
                 let body = self.loaded_body(body)?;
                 LoadKind::Torque { body, value }
             }
-            crate::spec::LoadKind::Spring {
+            crate::syntax::spec::LoadKind::Spring {
                 a,
                 b,
                 stiffness,
@@ -119,6 +119,27 @@ impl Checker {
         ];
         let (pa, pb) = (self.point(a), self.point(b));
         let (pa, pb) = (pa?, pb?);
+        let terms = self.spring_terms(span, stiffness, length, damping);
+        let ends = self.spring_ends(a, b, pa, pb);
+        let valid = terms && ends;
+        let [stiffness, length, damping] = constants;
+        valid.then_some(LoadKind::Spring {
+            a: pa,
+            b: pb,
+            stiffness,
+            length,
+            damping,
+        })
+    }
+
+    /// A stiffness with its free length, or a damping, or both; reports what is missing.
+    fn spring_terms(
+        &mut self,
+        span: Span,
+        stiffness: &Option<Expr>,
+        length: &Option<Expr>,
+        damping: &Option<Expr>,
+    ) -> bool {
         let mut valid = true;
         if stiffness.is_none() && damping.is_none() {
             self.errors.push(
@@ -146,6 +167,12 @@ impl Checker {
             }
             _ => {}
         }
+        valid
+    }
+
+    /// Two ends on different bodies, not both fixed; reports which rule they break.
+    fn spring_ends(&mut self, a: &PointRef, b: &PointRef, pa: Point, pb: Point) -> bool {
+        let mut valid = true;
         if pa.body == pb.body {
             self.errors.push(
                 b.body.span(),
@@ -167,14 +194,7 @@ impl Checker {
             );
             valid = false;
         }
-        let [stiffness, length, damping] = constants;
-        valid.then_some(LoadKind::Spring {
-            a: pa,
-            b: pb,
-            stiffness,
-            length,
-            damping,
-        })
+        valid
     }
 
     /// The point a force acts at, on a moving body.
@@ -254,7 +274,7 @@ impl Checker {
 #[cfg(test)]
 mod tests {
     use crate::model::{LoadKind, Outputs};
-    use crate::source::parse_str;
+    use crate::syntax::source::parse_str;
 
     const ARM: &str = "
         ground frame at (0, 0, 0);

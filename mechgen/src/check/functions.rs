@@ -12,10 +12,10 @@ use proc_macro2::Span;
 use syn::Ident;
 
 use super::Checker;
+use super::resolution::{MIN_LENGTH, RESOLUTION};
+use crate::expr::spline::SplineTable;
 use crate::expr::{Func, Func2, Id};
-use crate::resolution::{MIN_LENGTH, RESOLUTION};
-use crate::spec::{Expr, ExprKind};
-use crate::spline::SplineTable;
+use crate::syntax::spec::{Expr, ExprKind};
 
 /// Every function name, with how it is called, for error messages.
 const FUNCTIONS: [&str; 16] = [
@@ -148,7 +148,13 @@ impl Checker {
             .collect();
         let a = lowered[0];
         let b = lowered.get(1).copied().unwrap_or(a);
-        match name.as_str() {
+        self.apply(span, &name, a, b)
+    }
+
+    /// A built-in function of one or two lowered arguments (`b` is `a` for one), with the
+    /// constant-folding check where its domain is limited.
+    fn apply(&mut self, span: Span, name: &str, a: Id, b: Id) -> Id {
+        match name {
             "atan2" => {
                 let result = self.arena.call2(Func2::Atan2, a, b);
                 self.check_folded(span, result, &[a, b], "the result overflows an f64");
@@ -186,7 +192,7 @@ impl Checker {
                 self.clamped(a, rise)
             }
             _ => {
-                let func = Func::from_name(&name).unwrap_or(Func::Sqrt);
+                let func = Func::from_name(name).unwrap_or(Func::Sqrt);
                 let result = self.arena.call(func, a);
                 let hint = match func {
                     Func::Sqrt => "`sqrt` needs an argument ≥ 0",
@@ -281,6 +287,26 @@ impl Checker {
             return self.arena.zero();
         };
         let x = self.lower_with(x, allow_params, allow_t);
+        let (knots, knot_spans, values) =
+            match self.spline_points(points, usage, allow_params, allow_t) {
+                Some(points) => points,
+                None => return self.arena.zero(),
+            };
+        if !self.resolved_knots(&knots, &knot_spans) {
+            return self.arena.zero();
+        }
+        self.spline_sum(span, usage, x, &knots, &values)
+    }
+
+    /// A spline's points: the constant knots with their spans, and the lowered values; `None`
+    /// after an error (reported).
+    fn spline_points(
+        &mut self,
+        points: &[Expr],
+        usage: &str,
+        allow_params: bool,
+        allow_t: bool,
+    ) -> Option<(Vec<f64>, Vec<Span>, Vec<Id>)> {
         let mut knots = Vec::with_capacity(points.len());
         let mut knot_spans = Vec::with_capacity(points.len());
         let mut values = Vec::with_capacity(points.len());
@@ -290,14 +316,14 @@ impl Checker {
                     point.span,
                     format!("a spline point is a pair `(x, y)`; {usage}"),
                 );
-                return self.arena.zero();
+                return None;
             };
             let [knot, value] = pair.as_slice() else {
                 self.errors.push(
                     point.span,
                     format!("a spline point is a pair `(x, y)`; {usage}"),
                 );
-                return self.arena.zero();
+                return None;
             };
             // Parameters are let through here so that the message below names the rule.
             let knot_id = self.lower_with(knot, true, false);
@@ -312,15 +338,17 @@ impl Checker {
                         "a spline's x values must be constant numbers (they fix its knots); its \
                          y values may use parameters",
                     );
-                    return self.arena.zero();
+                    return None;
                 }
             }
             values.push(self.lower_with(value, allow_params, allow_t));
         }
-        if !self.resolved_knots(&knots, &knot_spans) {
-            return self.arena.zero();
-        }
-        // The constant values in one table, each other value weighting its cardinal spline.
+        Some((knots, knot_spans, values))
+    }
+
+    /// The spline of `x` through `knots` and `values`: the constant values in one table, each
+    /// other value weighting its cardinal spline.
+    fn spline_sum(&mut self, span: Span, usage: &str, x: Id, knots: &[f64], values: &[Id]) -> Id {
         let constants: Vec<f64> = values
             .iter()
             .map(|&v| self.arena.as_const(v).unwrap_or(0.0))
@@ -339,7 +367,7 @@ impl Checker {
             }
         }
         for (table_values, weight) in terms {
-            let table = match SplineTable::natural(&knots, &table_values) {
+            let table = match SplineTable::natural(knots, &table_values) {
                 Ok(table) => table,
                 Err(message) => {
                     self.errors.push(span, format!("{message}; {usage}"));

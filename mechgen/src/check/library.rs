@@ -8,7 +8,7 @@ use syn::Ident;
 use super::Checker;
 use crate::expr::{Func, Id};
 use crate::model::{ConstraintKind, Driven, Marker, MarkerKind, Point};
-use crate::spec::{DriverKind, Expr, JointKind, MarkerDecl, PointRef};
+use crate::syntax::spec::{DriverKind, Expr, JointKind, MarkerDecl, PointRef};
 
 impl Checker {
     /// A joint of the spec as a constraint of the model.
@@ -69,34 +69,43 @@ impl Checker {
                 pinion,
                 ratio,
                 phase,
-            } => {
-                let ratio_id = self.nonzero_ratio(ratio);
-                let phase = self.optional_geometry(phase.as_ref());
-                let guide =
-                    self.prismatic_joint(joint, "`rack` couples the slider of a `prismatic` joint");
-                let pinion_body = self.body(pinion);
-                let (a, b, axis) = guide?;
-                let pinion_body = pinion_body?;
-                if pinion_body == b.body {
-                    self.errors.push(
-                        pinion.span(),
-                        format!(
-                            "`{pinion}` is the rack itself (the slider of `{joint}`); name the \
-                             pinion that drives it"
-                        ),
-                    );
-                    return None;
-                }
-                Some(ConstraintKind::Rack {
-                    a,
-                    b,
-                    axis,
-                    pinion: pinion_body,
-                    ratio: ratio_id?,
-                    phase,
-                })
-            }
+            } => self.rack(joint, pinion, ratio, phase.as_ref()),
         }
+    }
+
+    /// `rack(joint, pinion, ratio k, phase φ)`: the slider of a `prismatic` joint driven by a
+    /// pinion that is not the rack itself, and a ratio that is not zero.
+    fn rack(
+        &mut self,
+        joint: &Ident,
+        pinion: &Ident,
+        ratio: &Expr,
+        phase: Option<&Expr>,
+    ) -> Option<ConstraintKind> {
+        let ratio_id = self.nonzero_ratio(ratio);
+        let phase = self.optional_geometry(phase);
+        let guide = self.prismatic_joint(joint, "`rack` couples the slider of a `prismatic` joint");
+        let pinion_body = self.body(pinion);
+        let (a, b, axis) = guide?;
+        let pinion_body = pinion_body?;
+        if pinion_body == b.body {
+            self.errors.push(
+                pinion.span(),
+                format!(
+                    "`{pinion}` is the rack itself (the slider of `{joint}`); name the \
+                     pinion that drives it"
+                ),
+            );
+            return None;
+        }
+        Some(ConstraintKind::Rack {
+            a,
+            b,
+            axis,
+            pinion: pinion_body,
+            ratio: ratio_id?,
+            phase,
+        })
     }
 
     /// `gear(a, b, ratio k, carrier c, phase φ)`: three different bodies, not all of them
@@ -208,8 +217,8 @@ impl Checker {
     /// A marker: a point on a known body, or the angle between two different bodies.
     pub(super) fn marker(&mut self, decl: &MarkerDecl) -> Option<Marker> {
         let kind = match &decl.kind {
-            crate::spec::MarkerKind::Point(p) => MarkerKind::Point(self.point(p)?),
-            crate::spec::MarkerKind::Angle(a, b) => {
+            crate::syntax::spec::MarkerKind::Point(p) => MarkerKind::Point(self.point(p)?),
+            crate::syntax::spec::MarkerKind::Angle(a, b) => {
                 let (ia, ib) = (self.body(a), self.body(b));
                 let (ia, ib) = (ia?, ib?);
                 if ia == ib {

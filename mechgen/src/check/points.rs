@@ -9,7 +9,7 @@ use std::collections::HashMap;
 use proc_macro2::Ident;
 
 use crate::error::Errors;
-use crate::spec::{DriverKind, JointKind, LoadKind, MarkerKind, PointRef, Spec};
+use crate::syntax::spec::{DriverKind, JointKind, LoadKind, MarkerKind, PointRef, Spec};
 
 /// `spec` with every use of a named point replaced by the point; `None` when it declares none.
 /// Reports a point declared on an unknown body or on another named point, and a use with an
@@ -18,6 +18,38 @@ pub(super) fn substitute(spec: &Spec, errors: &mut Errors) -> Option<Spec> {
     if spec.points.is_empty() {
         return None;
     }
+    let points = declared(spec, errors);
+    let mut spec = spec.clone();
+    let replace = |p: &mut PointRef| {
+        let Some(point) = points.get(&p.body.to_string()) else {
+            return;
+        };
+        let body = Ident::new(&point.body.to_string(), p.body.span());
+        if p.local.is_some() {
+            errors.push(
+                p.body.span(),
+                format!(
+                    "`{}` is a named point, which takes no `@ (x, y)`: for another point of its \
+                     body write `{} @ (x, y)`",
+                    p.body, point.body
+                ),
+            );
+            // Checked on as that point of the body, so that this is the only error.
+            p.body = body;
+            return;
+        }
+        *p = PointRef {
+            body,
+            local: point.local.clone(),
+        };
+    };
+    for_each_use(&mut spec, replace);
+    Some(spec)
+}
+
+/// The declared points by name; reports a point declared on an unknown body or on another
+/// named point.
+fn declared(spec: &Spec, errors: &mut Errors) -> HashMap<String, PointRef> {
     let bodies: Vec<String> = spec.bodies.iter().map(|b| b.name.to_string()).collect();
     let mut points: HashMap<String, PointRef> = HashMap::new();
     for decl in &spec.points {
@@ -41,30 +73,12 @@ pub(super) fn substitute(spec: &Spec, errors: &mut Errors) -> Option<Spec> {
             .entry(decl.name.to_string())
             .or_insert_with(|| decl.point.clone());
     }
-    let mut spec = spec.clone();
-    let mut replace = |p: &mut PointRef| {
-        let Some(point) = points.get(&p.body.to_string()) else {
-            return;
-        };
-        let body = Ident::new(&point.body.to_string(), p.body.span());
-        if p.local.is_some() {
-            errors.push(
-                p.body.span(),
-                format!(
-                    "`{}` is a named point, which takes no `@ (x, y)`: for another point of its \
-                     body write `{} @ (x, y)`",
-                    p.body, point.body
-                ),
-            );
-            // Checked on as that point of the body, so that this is the only error.
-            p.body = body;
-            return;
-        }
-        *p = PointRef {
-            body,
-            local: point.local.clone(),
-        };
-    };
+    points
+}
+
+/// Calls `replace` on every point written in `spec`'s joints, drivers, markers, branches and
+/// loads.
+fn for_each_use(spec: &mut Spec, mut replace: impl FnMut(&mut PointRef)) {
     for joint in &mut spec.joints {
         match &mut joint.kind {
             JointKind::Revolute { a, b }
@@ -103,7 +117,6 @@ pub(super) fn substitute(spec: &Spec, errors: &mut Errors) -> Option<Spec> {
             LoadKind::Torque { .. } => {}
         }
     }
-    Some(spec)
 }
 
 fn list(names: &[String]) -> String {

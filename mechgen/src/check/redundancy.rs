@@ -5,8 +5,8 @@
 //! whole loop); this test singles out the ones a user can delete: the extra joint, a copy of a
 //! joint, or a driver of a mechanism its joints already hold rigid.
 
-use crate::graph;
 use crate::model::{ConstraintKind, Model, Point};
+use crate::sparse::graph;
 
 /// The constraints (indices into `model.constraints`) among `candidates` whose removal keeps
 /// the structural rank: all their equations are structurally redundant. `rows[e]` lists the

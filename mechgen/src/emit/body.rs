@@ -11,10 +11,10 @@ use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 
 use super::{CodegenOptions, idx};
+use crate::expr::tape::topological_order_with;
 use crate::expr::{Arena, Func, Id, Node, Var};
-use crate::interpret::topological_order_with;
 use crate::model::{COORDINATE_SUFFIXES, Model};
-use crate::stats::OpCounts;
+use crate::plan::stats::OpCounts;
 
 /// One generated function body with the names its arguments must take (`q` or `_q` if unused).
 pub(super) struct Function {
@@ -100,7 +100,7 @@ pub(super) struct Context<'a> {
     /// The model's equation names, for naming multipliers (`lambda_crank_pin_x`).
     pub equations: Vec<String>,
     /// The force solve, for a scene that computes forces.
-    pub forces: Option<&'a crate::reactions::Forces>,
+    pub forces: Option<&'a crate::plan::reactions::Forces>,
     /// The markers' values (from the kinematics).
     pub markers: &'a [Id],
     /// Two values per load naming the one that makes F non-finite (`Scene::load_witnesses`).

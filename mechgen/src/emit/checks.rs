@@ -1,4 +1,4 @@
-//! The run-time checks of values written in parameters (`crate::geometry`, `crate::physics`):
+//! The run-time checks of values written in parameters (`crate::model::geometry`, `crate::model::physics`):
 //! `check_geometry` and `check_physics`, each evaluating its values with the current
 //! parameters and checking them against their rules in declaration order; nothing for a scene
 //! whose values are constant.
@@ -8,8 +8,8 @@ use quote::{format_ident, quote};
 
 use super::body::Context;
 use super::idx;
-use crate::geometry::Check;
-use crate::physics::Subject;
+use crate::model::geometry::Check;
+use crate::model::physics::Subject;
 
 /// What a check names, as the runtime's checking function takes it.
 pub(super) trait Named: Copy {

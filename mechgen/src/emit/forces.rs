@@ -12,7 +12,7 @@ use quote::{format_ident, quote};
 use super::body::{Context, computed};
 use super::{idx, signature_with};
 use crate::model::ConstraintKind;
-use crate::reactions::Forces;
+use crate::plan::reactions::Forces;
 
 impl Context<'_> {
     /// `generalized_forces`, `reactions` and `reaction_name` for `impl Mechanism`.

@@ -7,7 +7,7 @@ use quote::{format_ident, quote};
 
 use super::body::Context;
 use super::idx;
-use crate::factor::Factorization;
+use crate::sparse::factor::Factorization;
 
 /// The static LU `k` as straight-line code: the same operations, in the same order, as
 /// [`Factorization::factor`], [`Factorization::solve`] and [`Factorization::solve_transpose`].

@@ -8,8 +8,8 @@ use quote::{format_ident, quote};
 
 use super::body::{Context, computed};
 use super::idx;
-use crate::kernels::{Kernel, Kernels};
 use crate::model::{MarkerKind, Outputs};
+use crate::plan::kernels::{Kernel, Kernels};
 
 impl Context<'_> {
     /// Number of marker values.

@@ -23,10 +23,10 @@ use quote::{format_ident, quote};
 pub use body::f64_literal;
 use body::{Context, Function, computed};
 
-use crate::Scene;
 use crate::expr::{Arena, Id};
-use crate::kinematics::Kinematics;
+use crate::model::kinematics::Kinematics;
 use crate::model::{Outputs, Unit};
+use crate::plan::Scene;
 
 /// Choices that shape the generated code without changing its meaning.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -710,7 +710,7 @@ fn clear_if_sparse(arena: &Arena, values: &[Id], target: &TokenStream) -> TokenS
 impl Context<'_> {
     /// `length_scale`: the constant lengths folded into one literal, the parameter-dependent
     /// ones evaluated and folded in with `max(|v|)`, in the order of
-    /// [`LengthScale::evaluate`](crate::kinematics::LengthScale::evaluate).
+    /// [`LengthScale::evaluate`](crate::model::kinematics::LengthScale::evaluate).
     fn length_scale(&self, kin: &Kinematics) -> TokenStream {
         let scale = &kin.length_scale;
         let constant = f64_literal(scale.constant);

@@ -1,5 +1,5 @@
 //! The solve structure as code: `impl Structured` for a scene, rendered from the kernel list
-//! (`crate::kernels`). Each kernel becomes a function (`stage_3_positions`); each `Structured`
+//! (`crate::plan::kernels`). Each kernel becomes a function (`stage_3_positions`); each `Structured`
 //! method a dispatch on the stage index over the kernels it runs; the stage table and the
 //! static LUs come from `stages` and `lu`.
 
@@ -12,8 +12,8 @@ use super::idx;
 use super::lu::lu_functions;
 use super::stages::stage_table;
 use crate::expr::Id;
-use crate::kernels::{Kernels, Method, StageKernel};
-use crate::structure::Plan;
+use crate::plan::kernels::{Kernels, Method, StageKernel};
+use crate::plan::structure::Plan;
 
 /// A `Structured` method written by the emitter: a kernel method, or one of the three that run
 /// a block's static LU.

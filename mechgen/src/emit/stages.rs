@@ -5,9 +5,9 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::idx;
-use crate::kernels::StageShape;
 use crate::model::Model;
-use crate::structure::{Block, Plan, Stage};
+use crate::plan::kernels::StageShape;
+use crate::plan::structure::{Block, Plan, Stage};
 
 /// The `STAGES` constant, documented stage by stage: the kernel list's stage shapes, with the
 /// plan's stages for the documentation.

@@ -52,14 +52,14 @@ struct NewtonEuler<'a> {
 
 impl NewtonEuler<'_> {
     fn value(&self, id: mechgen::expr::Id) -> f64 {
-        let env = mechgen::interpret::Env {
+        let env = mechgen::expr::tape::Env {
             q: self.q.clone(),
             qd: self.qd.clone(),
             qdd: Vec::new(),
             t: self.t,
             params: self.params.clone(),
         };
-        mechgen::interpret::eval(&self.scene.model.arena, id, &env)
+        mechgen::expr::tape::eval(&self.scene.model.arena, id, &env)
     }
 
     fn q(&self, k: usize) -> f64 {

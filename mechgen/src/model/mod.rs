@@ -2,11 +2,24 @@
 //!
 //! Built only by `check`, so everything here is known to be consistent: bodies exist, the
 //! system is square (drivers match the degrees of freedom), geometry does not depend on time.
+//!
+//! What is derived from it: body frames as every stage writes through them (`frames`), the
+//! constraint equations and their derivatives ([`kinematics`]), marker values ([`markers`]),
+//! the generalised forces ([`dynamics`]), and the run-time rules on geometry and mass
+//! properties written in parameters ([`geometry`], [`physics`]).
+
+pub mod dynamics;
+mod frames;
+pub mod geometry;
+pub mod kinematics;
+pub mod markers;
+pub mod motion;
+pub mod physics;
 
 use syn::{Attribute, Ident, Visibility};
 
 use crate::expr::{Arena, Id};
-pub use crate::spec::{Product, Sign};
+pub use crate::syntax::spec::{Product, Sign};
 
 /// The checked mechanism.
 #[derive(Clone)]
@@ -637,7 +650,8 @@ mod tests {
                 {outputs}
             }}"
         );
-        crate::compile_str(&source).unwrap_or_else(|e| panic!("{e}"))
+        crate::compile(crate::Input::Text(&source), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}"))
     }
 
     #[test]

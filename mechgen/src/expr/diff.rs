@@ -187,7 +187,7 @@ fn binary_derivative(arena: &mut Arena, f: Func2, [a, b]: [Id; 2], [da, db]: [Id
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::interpret::{Env, eval};
+    use crate::expr::tape::{Env, eval};
 
     /// Central difference of `e` in `var` at the environment, for checking rules numerically.
     fn numeric(arena: &Arena, e: Id, env: &Env, var: Var) -> f64 {
@@ -228,9 +228,11 @@ mod tests {
         let half = a.constant(2.5);
         cases.push(a.call2(Func2::Pow, y, half));
         cases.push(a.select(x, y, quotient, scaled));
-        let table =
-            crate::spline::SplineTable::natural(&[0.0, 0.5, 1.0, 2.0], &[1.0, 0.2, 0.4, -1.0])
-                .expect("a valid spline");
+        let table = crate::expr::spline::SplineTable::natural(
+            &[0.0, 0.5, 1.0, 2.0],
+            &[1.0, 0.2, 0.4, -1.0],
+        )
+        .expect("a valid spline");
         let table = a.add_spline(table);
         let product = a.mul(x, y);
         cases.push(a.spline(table, 0, product));

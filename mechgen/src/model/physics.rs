@@ -11,7 +11,7 @@
 
 use std::collections::HashSet;
 
-use crate::geometry::{Requirement, first_parameter};
+use crate::model::geometry::{Requirement, first_parameter};
 use crate::model::{LoadKind, Model};
 
 /// What a checked value belongs to (mirrors `mechgen_runtime::Subject`).
@@ -24,7 +24,7 @@ pub enum Subject {
 }
 
 /// One parameter-dependent mass property or load constant to check at run time.
-pub type Check = crate::geometry::Check<Subject>;
+pub type Check = crate::model::geometry::Check<Subject>;
 
 /// Every parameter-dependent mass property and load constant of `model`, each once per body or
 /// load, in declaration order (bodies, then loads).
@@ -81,8 +81,9 @@ mod tests {
 
     #[test]
     fn only_parameter_dependent_physics_is_checked_and_named() {
-        let scene = crate::compile_str(
-            "mechanism M {
+        let scene = crate::compile(
+            crate::Input::Text(
+                "mechanism M {
                 param m = 2.0;
                 param k = 500.0;
                 ground frame at (0, 0, 0);
@@ -94,6 +95,8 @@ mod tests {
                 driver spin: angle(crank) = t;
                 load coil: spring(frame @ (0.6, 0.1), slider, stiffness k, length 0.2);
             }",
+            ),
+            &crate::Options::default(),
         )
         .unwrap_or_else(|e| panic!("{:?}", e.messages()));
         let found: Vec<(Requirement, Subject, usize)> = scene

@@ -28,11 +28,11 @@
 
 use std::collections::HashMap;
 
-use crate::diff::Differentiator;
+use crate::expr::diff::Differentiator;
 use crate::expr::{Arena, Id, Var, var_index};
-use crate::kinematics::Kinematics;
+use crate::model::kinematics::Kinematics;
 use crate::model::{ConstraintKind, Model};
-use crate::structure::{Plan, Stage};
+use crate::plan::structure::{Plan, Stage};
 
 /// A scene's force solve: the generalised forces, the reverse stages and the reported
 /// reactions (ids into the model's arena).
@@ -353,7 +353,7 @@ fn reported(model: &mut Model, kin: &Kinematics) -> Vec<Id> {
 /// through the frame's coordinates, `−Σ_i ∂Φ_i/∂q_k λ_i` at the frame's pose, plus the pull of
 /// the springs anchored to it.
 fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
-    let mut loads = crate::dynamics::ground_spring_loads(model);
+    let mut loads = crate::model::dynamics::ground_spring_loads(model);
     debug_assert_eq!(loads.len(), n);
     let ground: Vec<(usize, [Id; 3])> = model
         .bodies
@@ -365,7 +365,7 @@ fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
     if ground.is_empty() {
         return loads;
     }
-    let textbook = crate::kinematics::textbook_equations(model);
+    let textbook = crate::model::kinematics::textbook_equations(model);
     // Ground equations touch only their own body, and their multipliers are not loads.
     let ground_rows: Vec<bool> = model
         .constraints
@@ -405,12 +405,13 @@ fn ground_loads(model: &mut Model, n: usize) -> Vec<Id> {
 #[cfg(test)]
 mod tests {
     use super::{ForceStage, assert_reads_later_stages, resolution_order};
+    use crate::expr::tape::{Inputs, Tape};
     use crate::expr::{Arena, Id, Var, var_index};
-    use crate::interpret::{Inputs, Tape};
-    use crate::structure::Stage;
+    use crate::plan::structure::Stage;
 
     fn compile(source: &str) -> crate::Scene {
-        crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"))
+        crate::compile(crate::Input::Text(source), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}"))
     }
 
     /// `id` at positions `q` and multipliers `lambda` (at rest, t = 0, default parameters).
@@ -588,7 +589,11 @@ mod tests {
     /// The scene's force stages with the first multiplier of stage `s` made to read the
     /// multiplier of `equation`, checked.
     fn check_with_read(s: usize, equation: impl Fn(&[Stage]) -> usize) {
-        let mut scene = crate::compile_str(PRISMATIC_TORQUE).unwrap_or_else(|e| panic!("{e}"));
+        let mut scene = crate::compile(
+            crate::Input::Text(PRISMATIC_TORQUE),
+            &crate::Options::default(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
         let mut stages = scene.forces.expect("computes forces").stages;
         let n = scene.kinematics.phi.len();
         let read = equation(&scene.plan.stages);
@@ -607,7 +612,11 @@ mod tests {
 
     #[test]
     fn the_planned_stages_read_only_later_multipliers() {
-        let scene = crate::compile_str(PRISMATIC_TORQUE).unwrap_or_else(|e| panic!("{e}"));
+        let scene = crate::compile(
+            crate::Input::Text(PRISMATIC_TORQUE),
+            &crate::Options::default(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
         let stages = scene.forces.expect("computes forces").stages;
         assert!(stages.len() >= 2, "a fixed stage and the driver's");
         let n = scene.kinematics.phi.len();

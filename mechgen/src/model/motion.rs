@@ -13,7 +13,7 @@
 
 use std::collections::HashMap;
 
-use crate::diff::Differentiator;
+use crate::expr::diff::Differentiator;
 use crate::expr::{Arena, Id, Var, var_index};
 
 /// One structurally non-zero entry of a sparse matrix: (row, column, value).
@@ -91,13 +91,14 @@ fn negated_jacobian(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::interpret::{Env, eval};
+    use crate::expr::tape::{Env, eval};
 
     /// The motion of `source`'s scene, with its arena.
     fn motion(source: &str) -> (Arena, Motion) {
-        let scene = crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"));
+        let scene = crate::compile(crate::Input::Text(source), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}"));
         let mut model = scene.model;
-        let generalized = crate::dynamics::derive(&mut model);
+        let generalized = crate::model::dynamics::derive(&mut model);
         let motion = derive(&mut model.arena, &generalized);
         (model.arena, motion)
     }

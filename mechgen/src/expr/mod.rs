@@ -6,6 +6,13 @@
 //! emitter binds each of them once. The constructors simplify as they build (constant folding,
 //! `x·0`, `x·1`, `x+0`, `−(−x)`, functions of constants), so no separate simplification pass can be
 //! forgotten and no identically-zero expression survives as anything but [`Arena::zero`].
+//!
+//! Around the arena: symbolic derivatives ([`diff`]), evaluation by tape ([`tape`]) and the
+//! cubic spline tables that `spline(...)` values read ([`spline`]).
+
+pub mod diff;
+pub mod spline;
+pub mod tape;
 
 use std::collections::{HashMap, HashSet};
 
@@ -202,7 +209,7 @@ pub struct Arena {
     /// False only for the naive baseline ([`Arena::unsimplified`]).
     simplify: bool,
     /// The spline tables [`Node::Spline`] refers to.
-    splines: Vec<crate::spline::SplineTable>,
+    splines: Vec<crate::expr::spline::SplineTable>,
 }
 
 impl Default for Arena {
@@ -521,18 +528,18 @@ impl Arena {
     }
 
     /// Adds a spline table, returning its index for [`Arena::spline`].
-    pub fn add_spline(&mut self, table: crate::spline::SplineTable) -> u32 {
+    pub fn add_spline(&mut self, table: crate::expr::spline::SplineTable) -> u32 {
         self.splines.push(table);
         u32::try_from(self.splines.len() - 1).expect("spline tables exceed u32")
     }
 
     /// The spline tables, by index.
-    pub fn spline_tables(&self) -> &[crate::spline::SplineTable] {
+    pub fn spline_tables(&self) -> &[crate::expr::spline::SplineTable] {
         &self.splines
     }
 
     /// Spline table `table`, if it exists.
-    pub fn spline_table(&self, table: u32) -> Option<&crate::spline::SplineTable> {
+    pub fn spline_table(&self, table: u32) -> Option<&crate::expr::spline::SplineTable> {
         self.splines.get(table as usize)
     }
 

@@ -1,4 +1,5 @@
-//! The interpreter: evaluates the IR directly, for tests, the CLI and as the baseline that a
+//! Evaluating the IR numerically: the tape every run-time evaluation of an expression goes
+//! through (the interpreter crate, the checker's constants, tests), and the baseline that a
 //! run-time (non-generated) library would be.
 //!
 //! A [`Tape`] linearises the DAG reachable from a set of outputs once (topological order, each
@@ -12,8 +13,8 @@
 use core::ops::{Add, Div, Mul, Neg, Sub};
 use std::collections::{HashMap, HashSet};
 
+use crate::expr::spline::SplineTable;
 use crate::expr::{Arena, Func, Func2, Id, Node, Var};
-use crate::spline::SplineTable;
 
 /// A number type a [`Tape`] can evaluate over: `f64`, or e.g. a dual number for forward-mode
 /// automatic differentiation (implemented by a newtype in the crate that owns the dual type).

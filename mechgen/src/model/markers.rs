@@ -4,9 +4,9 @@
 //! symbols, the second reading q̈), taken only as far as the scene's outputs go, so a
 //! positions-only scene gets positions only.
 
-use crate::diff::Differentiator;
 use crate::expr::Id;
-use crate::frames::{Frames, ground_poses};
+use crate::expr::diff::Differentiator;
+use crate::model::frames::{Frames, ground_poses};
 use crate::model::{MarkerKind, Model, Outputs};
 
 /// Every marker's values in layout order ([`Model::marker_names`]): its positions, then their
@@ -48,12 +48,13 @@ pub fn values(model: &mut Model) -> Vec<Id> {
 
 #[cfg(test)]
 mod tests {
-    use crate::interpret::{Env, eval};
+    use crate::expr::tape::{Env, eval};
 
     #[test]
     fn a_point_and_an_angle_with_their_rates() {
-        let scene = crate::compile_str(
-            "mechanism M {
+        let scene = crate::compile(
+            crate::Input::Text(
+                "mechanism M {
                 ground frame at (0, 0, 0);
                 body arm near (0, 0, 0);
                 body hand near (2, 0, 0);
@@ -64,6 +65,8 @@ mod tests {
                 marker tip: hand @ (1, 0);
                 marker wrist: angle(arm, hand);
             }",
+            ),
+            &crate::Options::default(),
         )
         .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(

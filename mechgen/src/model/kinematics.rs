@@ -6,9 +6,9 @@
 //! motion with q̇ held as independent symbols and dropping the q̈ term:
 //! γ = −(∂Φ̇/∂q · q̇ + ∂Φ̇/∂t) = −(Φ_q q̇)_q q̇ − 2 Φ_qt q̇ − Φ_tt.
 
-use crate::diff::Differentiator;
+use crate::expr::diff::Differentiator;
 use crate::expr::{Arena, Id, Node, Var, var_index};
-use crate::frames::{Frames, ground_poses};
+use crate::model::frames::{Frames, ground_poses};
 use crate::model::{Branch, ConstraintKind, Model, Outputs, Product, Sign};
 
 /// A structural non-zero of the Jacobian.
@@ -41,9 +41,9 @@ pub struct Kinematics {
     /// The scene's length scale: the largest magnitude among its geometric lengths.
     pub length_scale: LengthScale,
     /// The geometry written in parameters, with the rule each value must satisfy at run time.
-    pub geometry: Vec<crate::geometry::Check>,
+    pub geometry: Vec<crate::model::geometry::Check>,
     /// The mass properties and load constants written in parameters, with their rules.
-    pub physics: Vec<crate::physics::Check>,
+    pub physics: Vec<crate::model::physics::Check>,
     /// The markers' values and rates, in layout order ([`Model::marker_names`]).
     pub markers: Vec<Id>,
 }
@@ -70,7 +70,7 @@ impl LengthScale {
             } else {
                 // An unsimplified arena (naive baseline) does not fold: evaluate instead.
                 let value = arena.as_const(id).unwrap_or_else(|| {
-                    crate::interpret::eval(arena, id, &crate::interpret::Env::default())
+                    crate::expr::tape::eval(arena, id, &crate::expr::tape::Env::default())
                 });
                 constant = constant.max(value.abs());
             }
@@ -150,9 +150,9 @@ pub fn derive(model: &mut Model) -> Kinematics {
     let guess = model.bodies.iter().flat_map(|b| b.pose).collect();
     let branches = branch_values(model);
     let length_scale = LengthScale::of(&model.arena, &model.lengths());
-    let geometry = crate::geometry::checks(model);
-    let physics = crate::physics::checks(model);
-    let markers = crate::markers::values(model);
+    let geometry = crate::model::geometry::checks(model);
+    let physics = crate::model::physics::checks(model);
+    let markers = crate::model::markers::values(model);
     Kinematics {
         phi,
         jacobian,
@@ -326,10 +326,11 @@ fn equations_with(model: &mut Model, poses: &[Option<[Id; 3]>]) -> Vec<Id> {
 
 #[cfg(test)]
 mod tests {
-    use crate::interpret::{Env, eval};
+    use crate::expr::tape::{Env, eval};
 
     fn compile(source: &str) -> crate::Scene {
-        crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"))
+        crate::compile(crate::Input::Text(source), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}"))
     }
 
     #[test]

@@ -1,4 +1,4 @@
-//! The run-time counterpart of [`crate::resolution`]: the scene's geometry written in parameters
+//! The run-time counterpart of [`crate::check::resolution`]: the scene's geometry written in parameters
 //! (body-fixed points, distances, ground poses, prismatic axes, gear and rack ratios), each value
 //! with the rule it must satisfy, the joint it belongs to and a parameter it is computed from.
 //!
@@ -27,7 +27,7 @@ pub enum Requirement {
     Axis,
     /// A gear's or rack's ratio: finite and not zero.
     Ratio,
-    /// A body's mass: finite, at least zero ([`crate::physics`]).
+    /// A body's mass: finite, at least zero ([`crate::model::physics`]).
     Mass,
     /// A body's moment of inertia: finite, at least zero.
     Inertia,
@@ -59,7 +59,7 @@ impl Requirement {
 
 /// One parameter-dependent value to check at run time: geometry (here, `S` the first equation
 /// of the constraint it belongs to, the first constraint's if several share it) or a mass
-/// property or load constant ([`crate::physics`], `S` the body or load).
+/// property or load constant ([`crate::model::physics`], `S` the body or load).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Check<S = usize> {
     /// The value, an expression in parameters.
@@ -145,7 +145,8 @@ mod tests {
     use super::*;
 
     fn checks_of(source: &str) -> (Vec<Check>, crate::Scene) {
-        let scene = crate::compile_str(source).unwrap_or_else(|e| panic!("{:?}", e.messages()));
+        let scene = crate::compile(crate::Input::Text(source), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{:?}", e.messages()));
         (scene.kinematics.geometry.clone(), scene)
     }
 

@@ -4,9 +4,10 @@
 
 use std::fmt;
 
-use crate::Scene;
+use crate::expr::tape::topological_order;
 use crate::expr::{Arena, Func, Id, Node};
-use crate::interpret::topological_order;
+use crate::plan::Scene;
+use crate::plan::structure::{Assignment, Block, Plan, Stage};
 
 /// How many operations of each kind a straight-line evaluation performs (each DAG node once).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -203,24 +204,50 @@ pub fn table(scene: &Scene) -> String {
 /// LU's entries, fill-in and updates, and what it solves); scenes with many stages show the
 /// first and last ones and a histogram of block sizes.
 pub fn structure(scene: &Scene) -> String {
-    use crate::structure::Stage;
     const SHOWN: usize = 24;
     let (model, plan) = (&scene.model, &scene.plan);
-    let arena = &model.arena;
     let (coordinates, equations) = (model.coordinate_names(), model.equation_names());
-    let fixed = |assignments: &[crate::structure::Assignment]| {
-        assignments.iter().all(|a| arena.is_invariant(a.position))
-    };
+    let mut out = summary(scene);
+    out += &format!(
+        "{:>6}  {:<9}{:>5}{:>9}{:>6}{:>9}  solves (coordinate ← equation)\n",
+        "stage", "kind", "size", "entries", "fill", "updates"
+    );
+    let count = plan.stages.len();
+    for (s, stage) in plan.stages.iter().enumerate() {
+        if count > SHOWN && s == SHOWN - 8 {
+            out += &format!("{:>6}  … {} more stages\n", "", count - SHOWN);
+        }
+        if count > SHOWN && s >= SHOWN - 8 && s < count - 8 {
+            continue;
+        }
+        out += &stage_line(&model.arena, s, stage, &coordinates, &equations);
+    }
+    if count > SHOWN {
+        out += &block_sizes(plan);
+    }
+    out
+}
+
+/// Whether an explicit stage's values are fixed (invariant: no coordinate, no time).
+fn fixed(arena: &Arena, assignments: &[Assignment]) -> bool {
+    assignments.iter().all(|a| arena.is_invariant(a.position))
+}
+
+/// The summary: how the coordinates split into explicit and block stages, the static LUs'
+/// size, the trig cache, and for a scene that computes forces the force solve.
+fn summary(scene: &Scene) -> String {
+    let (model, plan) = (&scene.model, &scene.plan);
+    let arena = &model.arena;
     let explicit: usize = plan.assignments().count();
     let fixed_count: usize = plan
         .stages
         .iter()
         .filter_map(|s| match s {
-            Stage::Explicit(a) if fixed(a) => Some(a.len()),
+            Stage::Explicit(a) if fixed(arena, a) => Some(a.len()),
             _ => None,
         })
         .sum();
-    let blocks: Vec<&crate::structure::Block> = plan.blocks().collect();
+    let blocks: Vec<&Block> = plan.blocks().collect();
     let in_blocks: usize = blocks.iter().map(|b| b.equations.len()).sum();
     let (entries, fill, updates) =
         blocks
@@ -258,10 +285,17 @@ pub fn structure(scene: &Scene) -> String {
             blocks.iter().map(|b| b.slots()).sum::<usize>()
         );
     }
-    out += &format!(
-        "{:>6}  {:<9}{:>5}{:>9}{:>6}{:>9}  solves (coordinate ← equation)\n",
-        "stage", "kind", "size", "entries", "fill", "updates"
-    );
+    out
+}
+
+/// One stage's line of the table.
+fn stage_line(
+    arena: &Arena,
+    s: usize,
+    stage: &Stage,
+    coordinates: &[String],
+    equations: &[String],
+) -> String {
     let pairs = |cs: &[usize], es: &[usize]| {
         let shown: Vec<String> = cs
             .iter()
@@ -272,63 +306,56 @@ pub fn structure(scene: &Scene) -> String {
         let more = if cs.len() > 3 { ", …" } else { "" };
         format!("{}{more}", shown.join(", "))
     };
-    let count = plan.stages.len();
-    for (s, stage) in plan.stages.iter().enumerate() {
-        if count > SHOWN && s == SHOWN - 8 {
-            out += &format!("{:>6}  … {} more stages\n", "", count - SHOWN);
+    match stage {
+        Stage::Explicit(a) => {
+            let cs: Vec<usize> = a.iter().map(|a| a.coordinate).collect();
+            let es: Vec<usize> = a.iter().map(|a| a.equation).collect();
+            let kind = if fixed(arena, a) { "fixed" } else { "explicit" };
+            format!(
+                "{s:>6}  {kind:<9}{:>5}{:>9}{:>6}{:>9}  {}\n",
+                a.len(),
+                "",
+                "",
+                "",
+                pairs(&cs, &es)
+            )
         }
-        if count > SHOWN && s >= SHOWN - 8 && s < count - 8 {
-            continue;
+        Stage::Block(b) => {
+            let (e, f, u) = match &b.factorization {
+                Some(lu) => (
+                    lu.entries.to_string(),
+                    lu.fill().to_string(),
+                    lu.updates().to_string(),
+                ),
+                None => (b.entries.len().to_string(), "-".into(), "dense".into()),
+            };
+            format!(
+                "{s:>6}  {:<9}{:>5}{e:>9}{f:>6}{u:>9}  {}\n",
+                "block",
+                b.equations.len(),
+                pairs(&b.coordinates, &b.equations)
+            )
         }
-        out += &match stage {
-            Stage::Explicit(a) => {
-                let cs: Vec<usize> = a.iter().map(|a| a.coordinate).collect();
-                let es: Vec<usize> = a.iter().map(|a| a.equation).collect();
-                let kind = if fixed(a) { "fixed" } else { "explicit" };
-                format!(
-                    "{s:>6}  {kind:<9}{:>5}{:>9}{:>6}{:>9}  {}\n",
-                    a.len(),
-                    "",
-                    "",
-                    "",
-                    pairs(&cs, &es)
-                )
-            }
-            Stage::Block(b) => {
-                let (e, f, u) = match &b.factorization {
-                    Some(lu) => (
-                        lu.entries.to_string(),
-                        lu.fill().to_string(),
-                        lu.updates().to_string(),
-                    ),
-                    None => (b.entries.len().to_string(), "-".into(), "dense".into()),
-                };
-                format!(
-                    "{s:>6}  {:<9}{:>5}{e:>9}{f:>6}{u:>9}  {}\n",
-                    "block",
-                    b.equations.len(),
-                    pairs(&b.coordinates, &b.equations)
-                )
-            }
-        };
     }
-    if count > SHOWN {
-        let mut sizes: Vec<usize> = blocks.iter().map(|b| b.equations.len()).collect();
-        sizes.sort_unstable();
-        let mut histogram = Vec::new();
-        for size in sizes {
-            match histogram.last_mut() {
-                Some((s, n)) if *s == size => *n += 1,
-                _ => histogram.push((size, 1)),
-            }
+}
+
+/// "block sizes: 3 of 1, 1 of 4": how many blocks of each size.
+fn block_sizes(plan: &Plan) -> String {
+    let blocks: Vec<&Block> = plan.blocks().collect();
+    let mut sizes: Vec<usize> = blocks.iter().map(|b| b.equations.len()).collect();
+    sizes.sort_unstable();
+    let mut histogram = Vec::new();
+    for size in sizes {
+        match histogram.last_mut() {
+            Some((s, n)) if *s == size => *n += 1,
+            _ => histogram.push((size, 1)),
         }
-        let histogram: Vec<String> = histogram
-            .iter()
-            .map(|(size, n)| format!("{n} of {size}"))
-            .collect();
-        out += &format!("block sizes: {}\n", histogram.join(", "));
     }
-    out
+    let histogram: Vec<String> = histogram
+        .iter()
+        .map(|(size, n)| format!("{n} of {size}"))
+        .collect();
+    format!("block sizes: {}\n", histogram.join(", "))
 }
 
 #[cfg(test)]

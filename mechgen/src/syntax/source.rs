@@ -11,8 +11,8 @@
 use proc_macro2::{Span, TokenStream};
 use syn::parse::{ParseStream, Parser};
 
-use crate::limits::{Limits, MAX_DEPTH, MAX_STATEMENT_TOKENS};
-use crate::spec::Spec;
+use crate::syntax::limits::{Limits, MAX_DEPTH, MAX_STATEMENT_TOKENS};
+use crate::syntax::spec::Spec;
 
 /// Text lexed at once: large enough that a file has few chunks (a span's chunk is found by a
 /// linear search), small enough that its tokens are a few megabytes.
@@ -95,7 +95,7 @@ fn read_into(source: &str, limits: &Limits, locations: &mut Locations) -> syn::R
             format!(
                 "the scene is {} bytes, more than the {} bytes mechgen reads (the limit is \
                  reached here); raise the limit to read it (`--max-file-size` on the command \
-                 line, `mechgen::limits::Limits` in code)",
+                 line, `mechgen::Limits` in code)",
                 source.len(),
                 limits.bytes
             ),
@@ -111,7 +111,7 @@ fn read_into(source: &str, limits: &Limits, locations: &mut Locations) -> syn::R
         Origin { line: 1, column: 0 },
         locations,
         |input| {
-            let header = crate::parse::header(input)?;
+            let header = crate::syntax::parse::header(input)?;
             if !input.is_empty() {
                 return Err(input.error("expected `{`: the mechanism's body, `{ … }`"));
             }
@@ -125,11 +125,25 @@ fn read_into(source: &str, limits: &Limits, locations: &mut Locations) -> syn::R
         ));
     };
     let mut spec = Spec::new(docs, vis, name);
+    read_statements(source, open..close, &scan.ends, locations, &mut spec)?;
+    Ok(spec)
+}
+
+/// Parses the statements of the body (`body`: its braces' offsets), whose ends the scan found,
+/// into `spec`.
+fn read_statements(
+    source: &str,
+    body: std::ops::Range<usize>,
+    ends: &[usize],
+    locations: &mut Locations,
+    spec: &mut Spec,
+) -> syn::Result<()> {
     // Chunks of whole statements, each lexed as `{` + statements + `}` with the braces placed
     // on the characters just before and after it (the previous `;` or the body's `{`, and the
     // next statement or the body's `}`), so that every span lands on real text.
+    let (open, close) = (body.start, body.end);
     let mut start = open + 1;
-    let mut ends = scan.ends.iter().copied().peekable();
+    let mut ends = ends.iter().copied().peekable();
     let mut cursor = Cursor::default();
     loop {
         let mut end = start;
@@ -150,12 +164,12 @@ fn read_into(source: &str, limits: &Limits, locations: &mut Locations) -> syn::R
             let content;
             syn::braced!(content in input);
             while !content.is_empty() {
-                crate::parse::statement(&content, &mut spec)?;
+                crate::syntax::parse::statement(&content, spec)?;
             }
             Ok(())
         })?;
         if last {
-            return Ok(spec);
+            return Ok(());
         }
         start = end;
     }
@@ -179,7 +193,7 @@ fn lex_and_parse<T>(
         locations.chunks.push((first.span(), origin));
     }
     // The scan enforced these already; the token check is exact and cheap.
-    crate::limits::check(&tokens)?;
+    crate::syntax::limits::check(&tokens)?;
     parser.parse2(tokens)
 }
 
@@ -280,6 +294,7 @@ enum Problem {
 
 impl Problem {
     fn into_error(self, source: &str, locations: &mut Locations, limits: &Limits) -> syn::Error {
+        // Whole: one arm per problem, each its message.
         let describe = |at: usize| {
             let (line, column) = position(source, at);
             format!("line {line}, column {}", column + 1)
@@ -335,7 +350,7 @@ impl Problem {
                 format!(
                     "the scene has {statements} statements, more than the {} mechgen reads \
                      (this is the first beyond the limit); raise the limit to read it \
-                     (`--max-statements` on the command line, `mechgen::limits::Limits` in \
+                     (`--max-statements` on the command line, `mechgen::syntax::limits::Limits` in \
                      code)",
                     limits.statements
                 ),
@@ -355,6 +370,8 @@ impl Problem {
 /// the first statement that is too long, then too many statements, then trailing tokens, with
 /// the full size of what is too big (the scan goes on counting, allocating nothing).
 fn scan(source: &str, limits: &Limits) -> Scan {
+    // Whole: one pass over the text, each branch updating the same state (open brackets, the
+    // current statement's tokens, the problems found so far).
     let bytes = source.as_bytes();
     let mut scan = Scan {
         open: None,
@@ -399,12 +416,7 @@ fn scan(source: &str, limits: &Limits) -> Scan {
                 }
                 if stack.is_empty() && byte == b'{' && scan.open.is_none() {
                     // The body: the header before it is measured as a statement of its own.
-                    if tokens - 1 > MAX_STATEMENT_TOKENS && long.is_none() {
-                        long = Some(Problem::Long {
-                            start: statement_start.unwrap_or(i),
-                            tokens: tokens - 1,
-                        });
-                    }
+                    note_long(&mut long, statement_start.unwrap_or(i), tokens - 1);
                     scan.open = Some(i);
                     tokens = 0;
                     statement_start = None;
@@ -436,23 +448,13 @@ fn scan(source: &str, limits: &Limits) -> Scan {
         }
         let ended = byte == b';' && stack.len() == 1 && scan.open.is_some() || scan.close.is_some();
         if ended || end >= bytes.len() {
-            if tokens > MAX_STATEMENT_TOKENS && long.is_none() {
-                long = Some(Problem::Long {
-                    start: statement_start.unwrap_or(i),
-                    tokens,
-                });
-            }
+            note_long(&mut long, statement_start.unwrap_or(i), tokens);
             tokens = 0;
             statement_start = None;
         }
         i = end;
     }
-    if tokens > MAX_STATEMENT_TOKENS && long.is_none() {
-        long = Some(Problem::Long {
-            start: statement_start.unwrap_or(0),
-            tokens,
-        });
-    }
+    note_long(&mut long, statement_start.unwrap_or(0), tokens);
     scan.problem = if let Some(&open) = stack.last() {
         Some(Problem::Unclosed { open })
     } else if let Some(problem) = long {
@@ -463,6 +465,14 @@ fn scan(source: &str, limits: &Limits) -> Scan {
         trailing.map(|start| Problem::Trailing { start })
     };
     scan
+}
+
+/// Records a statement of `tokens` tokens from `start` as the first too long, if it is and no
+/// other was.
+fn note_long(long: &mut Option<Problem>, start: usize, tokens: usize) {
+    if tokens > MAX_STATEMENT_TOKENS && long.is_none() {
+        *long = Some(Problem::Long { start, tokens });
+    }
 }
 
 fn closing(open: u8) -> u8 {
@@ -500,16 +510,7 @@ fn token_end(bytes: &[u8], i: usize) -> Result<usize, &'static str> {
             .map_or(bytes.len(), |n| i + n));
     }
     if b == b'/' && at(i + 1) == b'*' {
-        let (mut depth, mut k) = (1usize, i + 2);
-        while depth > 0 {
-            match (at(k), at(k + 1)) {
-                (0, _) if k >= bytes.len() => return Err("block comment"),
-                (b'/', b'*') => (depth, k) = (depth + 1, k + 2),
-                (b'*', b'/') => (depth, k) = (depth - 1, k + 2),
-                _ => k += 1,
-            }
-        }
-        return Ok(k);
+        return block_comment_end(bytes, i);
     }
     if b == b'"' {
         return string_end(bytes, i + 1).map(|k| suffix_end(bytes, k));
@@ -518,65 +519,93 @@ fn token_end(bytes: &[u8], i: usize) -> Result<usize, &'static str> {
         return Ok(char_end(bytes, i));
     }
     if b.is_ascii_digit() {
-        let mut k = i + 1;
-        loop {
-            let c = at(k);
-            let fraction = c == b'.' && at(k + 1) != b'.' && !is_ident_start(at(k + 1));
-            let exponent_sign = (c == b'+' || c == b'-')
-                && matches!(at(k - 1), b'e' | b'E')
-                && at(k + 1).is_ascii_digit();
-            if is_ident_continue(c) || fraction || exponent_sign {
-                k += 1;
-            } else {
-                return Ok(k);
-            }
-        }
+        return Ok(number_end(bytes, i));
     }
     if is_ident_start(b) {
-        let mut k = i + 1;
-        while is_ident_continue(at(k)) {
-            k += 1;
-        }
-        let word = &bytes[i..k];
-        let raw = matches!(word, b"r" | b"br" | b"cr");
-        if raw && (at(k) == b'"' || at(k) == b'#' && matches!(at(k + 1), b'#' | b'"')) {
-            let hashes = bytes[k..].iter().take_while(|&&c| c == b'#').count();
-            let mut j = k + hashes + 1;
-            loop {
-                let Some(n) = bytes
-                    .get(j..)
-                    .and_then(|r| r.iter().position(|&c| c == b'"'))
-                else {
-                    return Err("raw string");
-                };
-                j += n + 1;
-                if bytes[j..]
-                    .iter()
-                    .take(hashes)
-                    .filter(|&&c| c == b'#')
-                    .count()
-                    == hashes
-                {
-                    return Ok(suffix_end(bytes, j + hashes));
-                }
-            }
-        }
-        if word == b"r" && at(k) == b'#' && is_ident_start(at(k + 1)) {
-            let mut j = k + 2;
-            while is_ident_continue(at(j)) {
-                j += 1;
-            }
-            return Ok(j);
-        }
-        if matches!(word, b"b" | b"c") && at(k) == b'"' {
-            return string_end(bytes, k + 1).map(|j| suffix_end(bytes, j));
-        }
-        if word == b"b" && at(k) == b'\'' {
-            return Ok(char_end(bytes, k));
-        }
-        return Ok(k);
+        return word_end(bytes, i);
     }
     Ok(i + 1)
+}
+
+/// Just after the block comment (nested ones included) that starts at `i`.
+fn block_comment_end(bytes: &[u8], i: usize) -> Result<usize, &'static str> {
+    let at = |k: usize| bytes.get(k).copied().unwrap_or(0);
+    let (mut depth, mut k) = (1usize, i + 2);
+    while depth > 0 {
+        match (at(k), at(k + 1)) {
+            (0, _) if k >= bytes.len() => return Err("block comment"),
+            (b'/', b'*') => (depth, k) = (depth + 1, k + 2),
+            (b'*', b'/') => (depth, k) = (depth - 1, k + 2),
+            _ => k += 1,
+        }
+    }
+    Ok(k)
+}
+
+/// Just after the number (with its suffix, fraction and exponent) that starts at `i`.
+fn number_end(bytes: &[u8], i: usize) -> usize {
+    let at = |k: usize| bytes.get(k).copied().unwrap_or(0);
+    let mut k = i + 1;
+    loop {
+        let c = at(k);
+        let fraction = c == b'.' && at(k + 1) != b'.' && !is_ident_start(at(k + 1));
+        let exponent_sign = (c == b'+' || c == b'-')
+            && matches!(at(k - 1), b'e' | b'E')
+            && at(k + 1).is_ascii_digit();
+        if is_ident_continue(c) || fraction || exponent_sign {
+            k += 1;
+        } else {
+            return k;
+        }
+    }
+}
+
+/// Just after the word that starts at `i`: an identifier or keyword, a raw identifier, or
+/// the prefixed string, raw string or byte character it begins.
+fn word_end(bytes: &[u8], i: usize) -> Result<usize, &'static str> {
+    let at = |k: usize| bytes.get(k).copied().unwrap_or(0);
+    let mut k = i + 1;
+    while is_ident_continue(at(k)) {
+        k += 1;
+    }
+    let word = &bytes[i..k];
+    let raw = matches!(word, b"r" | b"br" | b"cr");
+    if raw && (at(k) == b'"' || at(k) == b'#' && matches!(at(k + 1), b'#' | b'"')) {
+        let hashes = bytes[k..].iter().take_while(|&&c| c == b'#').count();
+        let mut j = k + hashes + 1;
+        loop {
+            let Some(n) = bytes
+                .get(j..)
+                .and_then(|r| r.iter().position(|&c| c == b'"'))
+            else {
+                return Err("raw string");
+            };
+            j += n + 1;
+            if bytes[j..]
+                .iter()
+                .take(hashes)
+                .filter(|&&c| c == b'#')
+                .count()
+                == hashes
+            {
+                return Ok(suffix_end(bytes, j + hashes));
+            }
+        }
+    }
+    if word == b"r" && at(k) == b'#' && is_ident_start(at(k + 1)) {
+        let mut j = k + 2;
+        while is_ident_continue(at(j)) {
+            j += 1;
+        }
+        return Ok(j);
+    }
+    if matches!(word, b"b" | b"c") && at(k) == b'"' {
+        return string_end(bytes, k + 1).map(|j| suffix_end(bytes, j));
+    }
+    if word == b"b" && at(k) == b'\'' {
+        return Ok(char_end(bytes, k));
+    }
+    Ok(k)
 }
 
 /// Just after the closing `"` of a string whose contents start at `k`.

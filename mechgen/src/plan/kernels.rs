@@ -14,9 +14,9 @@
 use std::collections::HashMap;
 
 use crate::expr::{Arena, Id};
-use crate::factor::Factorization;
-use crate::reactions::{ForceStage, Forces};
-use crate::structure::{Phase, Plan, Stage};
+use crate::plan::reactions::{ForceStage, Forces};
+use crate::plan::structure::{Phase, Plan, Stage};
+use crate::sparse::factor::Factorization;
 
 /// A kind of per-stage kernel: the `Structured` method that runs it.
 ///
@@ -535,12 +535,13 @@ mod tests {
     use crate::Scene;
 
     fn scene(source: &str) -> Scene {
-        crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"))
+        crate::compile(crate::Input::Text(source), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}"))
     }
 
-    const FOUR_BAR: &str = include_str!("../../examples/scenes/four_bar.mech");
-    const DYNAMICS: &str = include_str!("../../examples/scenes/piston_crank_dynamics.mech");
-    const OFFSET_SLIDER: &str = include_str!("../../examples/scenes/offset_slider.mech");
+    const FOUR_BAR: &str = include_str!("../../../examples/scenes/four_bar.mech");
+    const DYNAMICS: &str = include_str!("../../../examples/scenes/piston_crank_dynamics.mech");
+    const OFFSET_SLIDER: &str = include_str!("../../../examples/scenes/offset_slider.mech");
 
     /// Two four-bars side by side, each with its own crank: two blocks of one pattern.
     const TWIN_FOUR_BARS: &str = "pub mechanism Twins {

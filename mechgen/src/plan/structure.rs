@@ -23,13 +23,13 @@
 
 use std::collections::HashMap;
 
-use crate::diff::Differentiator;
+use crate::expr::diff::Differentiator;
+use crate::expr::tape::{Inputs, Tape};
 use crate::expr::{Arena, Func, Id, Node, Var, var_index};
-use crate::factor::{self, Factorization};
-use crate::graph;
-use crate::interpret::{Inputs, Tape};
-use crate::kinematics::Kinematics;
+use crate::model::kinematics::Kinematics;
 use crate::model::{Model, Outputs};
+use crate::sparse::factor::{self, Factorization};
+use crate::sparse::graph;
 
 /// Static factorisations with more updates than this are not emitted as straight-line code
 /// (rustc's time grows quickly with a function's size); such a block is factored with partial
@@ -107,7 +107,7 @@ impl TrigCache {
             Phase::After => self.filled_by[m] <= stage,
             Phase::Final => true,
         };
-        crate::interpret::topological_order(arena, roots)
+        crate::expr::tape::topological_order(arena, roots)
             .into_iter()
             .filter_map(|id| {
                 let &i = self.slot.get(&id)?;
@@ -322,7 +322,7 @@ fn trig_cache(arena: &mut Arena, stages: &[Stage], n: usize, final_roots: &[Id])
         .flat_map(|(s, stage)| kernel_roots(stage).map(|k| (s, k)))
         .chain([final_kernels]);
     for (s, (phase, roots)) in kernels {
-        for id in crate::interpret::topological_order(arena, &roots) {
+        for id in crate::expr::tape::topological_order(arena, &roots) {
             if let Node::Call(Func::Sin | Func::Cos, a) = arena.node(id)
                 && let Node::Var(Var::Q(k)) = arena.node(a)
             {
@@ -776,11 +776,12 @@ fn ranks(permutation: &[usize]) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::{Block, Phase, Stage, stage_coordinates};
+    use crate::expr::tape::{Env, eval};
     use crate::expr::{Arena, Func, Id, Node, Var};
-    use crate::interpret::{Env, eval};
 
     fn compile(source: &str) -> crate::Scene {
-        crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"))
+        crate::compile(crate::Input::Text(source), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}"))
     }
 
     /// A crank-rocker. Coordinates: frame 0–2, crank 3–5, coupler 6–8, rocker 9–11 (x, y, θ).
@@ -1089,11 +1090,14 @@ mod tests {
 
     #[test]
     fn the_naive_baseline_is_one_block_of_everything() {
-        let options = crate::CodegenOptions {
-            naive: true,
-            ..crate::CodegenOptions::default()
+        let options = crate::Options {
+            codegen: crate::CodegenOptions {
+                naive: true,
+                ..crate::CodegenOptions::default()
+            },
+            ..crate::Options::default()
         };
-        let scene = crate::compile_str_with(&four_bar(0.6, 1.1), &options)
+        let scene = crate::compile(crate::Input::Text(&four_bar(0.6, 1.1)), &options)
             .unwrap_or_else(|e| panic!("{e}"));
         let plan = &scene.plan;
         assert_eq!(plan.stages.len(), 1);

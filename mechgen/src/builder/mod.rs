@@ -2,11 +2,11 @@
 //! identical linkages), typically from a `build.rs` that writes the generated code into
 //! `OUT_DIR` for the crate to `include!`.
 //!
-//! [`SceneBuilder`] produces the spec *text* of [`crate::parse`]'s grammar, so a built scene goes
-//! through exactly the pipeline a hand-written one does and every check applies (unknown bodies,
-//! duplicate names, the Gruebler degree-of-freedom count, …). Names, numbers and expressions are
-//! checked early, as each statement is added; those errors and the checker's are returned
-//! together as [`Errors`].
+//! [`SceneBuilder`] produces the spec *text* of [`crate::syntax::parse`]'s grammar, so a built
+//! scene goes through exactly the pipeline a hand-written one does and every check applies
+//! (unknown bodies, duplicate names, the Gruebler degree-of-freedom count, …). Names, numbers
+//! and expressions are checked early, as each statement is added; those errors and the
+//! checker's are returned together as [`Errors`].
 //!
 //! ```
 //! use mechgen::builder::SceneBuilder;
@@ -35,114 +35,26 @@
 //! The line breaks matter (rustc is slow on very long lines); formatting with prettyplease (the
 //! `pretty` feature, `SceneBuilder::write_pretty_to`) adds nothing for rustc and costs more
 //! than the expansion itself on large scenes.
+//!
+//! This file is the builder's API; its arguments ([`Value`], [`Point`]) are in `values`, the
+//! token formatter ([`source_text`]) in `text`, and the file writing in `write`.
+
+mod text;
+mod values;
+mod write;
+
+pub use crate::syntax::spec::{Product, Sign};
+pub use text::source_text;
+pub use values::{Point, Value};
+pub use write::WriteError;
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
 
-use proc_macro2::{Delimiter, Spacing, Span, TokenStream, TokenTree};
+use proc_macro2::{Span, TokenStream};
 
 use crate::emit::CodegenOptions;
 use crate::error::Errors;
 use crate::model::Outputs;
-pub use crate::spec::{Product, Sign};
-
-/// A scalar of the spec: a number, or an expression in parameters (and `t` in drivers) written
-/// in the grammar's syntax, e.g. `"omega * t"` or `"0.5 * sin(2 * t)"`.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Value {
-    /// A finite number, written with its shortest round-trip representation.
-    Number(f64),
-    /// An expression in the grammar's syntax; checked for syntax when added.
-    Expr(String),
-}
-
-impl From<f64> for Value {
-    fn from(value: f64) -> Self {
-        Value::Number(value)
-    }
-}
-
-impl From<&str> for Value {
-    fn from(expr: &str) -> Self {
-        Value::Expr(expr.to_owned())
-    }
-}
-
-impl From<String> for Value {
-    fn from(expr: String) -> Self {
-        Value::Expr(expr)
-    }
-}
-
-impl From<&String> for Value {
-    fn from(expr: &String) -> Self {
-        Value::Expr(expr.clone())
-    }
-}
-
-/// A body-fixed point: a body's reference point (`"crank"`) or a point in its frame
-/// (`("crank", [0.0, 43.0])`).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Point {
-    /// The body the point is fixed to.
-    pub body: String,
-    /// Body-frame coordinates; `None` for the reference point.
-    pub local: Option<[f64; 2]>,
-}
-
-impl Point {
-    /// The point at `local` in `body`'s frame.
-    pub fn new(body: impl Into<String>, local: [f64; 2]) -> Self {
-        Point {
-            body: body.into(),
-            local: Some(local),
-        }
-    }
-
-    /// The reference point (origin) of `body`.
-    pub fn origin(body: impl Into<String>) -> Self {
-        Point {
-            body: body.into(),
-            local: None,
-        }
-    }
-}
-
-impl From<&str> for Point {
-    fn from(body: &str) -> Self {
-        Point::origin(body)
-    }
-}
-
-impl From<String> for Point {
-    fn from(body: String) -> Self {
-        Point::origin(body)
-    }
-}
-
-impl From<&String> for Point {
-    fn from(body: &String) -> Self {
-        Point::origin(body.as_str())
-    }
-}
-
-impl From<(&str, [f64; 2])> for Point {
-    fn from((body, local): (&str, [f64; 2])) -> Self {
-        Point::new(body, local)
-    }
-}
-
-impl From<(String, [f64; 2])> for Point {
-    fn from((body, local): (String, [f64; 2])) -> Self {
-        Point::new(body, local)
-    }
-}
-
-impl From<(&String, [f64; 2])> for Point {
-    fn from((body, local): (&String, [f64; 2])) -> Self {
-        Point::new(body.as_str(), local)
-    }
-}
 
 /// One statement of the scene, already rendered, with its doc lines.
 struct Item {
@@ -410,7 +322,7 @@ impl SceneBuilder {
 
     /// `branch NAME: cross(u.0 -> u.1, v.0 -> v.1) > 0;` (or `dot(…)`, or `< 0`): a branch
     /// invariant, the product of two world vectors between body-fixed points whose sign the
-    /// solver keeps (see [`crate::parse`]).
+    /// solver keeps (see [`crate::syntax::parse`]).
     ///
     /// ```
     /// # use mechgen::builder::{Product, SceneBuilder, Sign};
@@ -445,8 +357,8 @@ impl SceneBuilder {
         ))
     }
 
-    /// The scene as spec text (the grammar of [`crate::parse`]), ready for
-    /// [`crate::compile_str`] or a `.mech` file.
+    /// The scene as spec text (the grammar of [`crate::syntax::parse`]), ready for
+    /// [`crate::compile`] or a `.mech` file.
     ///
     /// # Errors
     /// Every invalid name, non-finite number and unparsable expression added, together. The
@@ -483,60 +395,18 @@ impl SceneBuilder {
         Ok(text)
     }
 
-    /// The generated Rust items: [`build`](Self::build), then [`crate::expand_str_with`].
+    /// The generated Rust items: [`build`](Self::build), then [`crate::expand`] with `options`,
+    /// the text read without size and count limits (a program wrote it).
     ///
     /// # Errors
     /// As [`build`](Self::build), then every error of the checker (see the module
     /// documentation on their locations).
     pub fn expand(&self, options: &CodegenOptions) -> Result<TokenStream, Errors> {
-        crate::expand_str_with(&self.build()?, options)
-    }
-
-    /// Writes the generated items to `path` as unformatted tokens, for `include!`. The file is
-    /// left untouched when it already holds exactly this text, so that nothing downstream is
-    /// rebuilt needlessly.
-    ///
-    /// # Errors
-    /// The scene's errors, or the file could not be written.
-    pub fn write_to(
-        &self,
-        path: impl AsRef<Path>,
-        options: &CodegenOptions,
-    ) -> Result<(), WriteError> {
-        let code = self.expand(options).map_err(WriteError::Scene)?;
-        write_if_changed(path.as_ref(), &generated_file(&source_text(code)))
-    }
-
-    /// As [`write_to`](Self::write_to), formatted with prettyplease for reading (much slower
-    /// on large scenes).
-    ///
-    /// # Errors
-    /// As [`write_to`](Self::write_to).
-    #[cfg(feature = "pretty")]
-    pub fn write_pretty_to(
-        &self,
-        path: impl AsRef<Path>,
-        options: &CodegenOptions,
-    ) -> Result<(), WriteError> {
-        let code = self.expand(options).map_err(WriteError::Scene)?;
-        write_if_changed(path.as_ref(), &generated_file(&crate::pretty(code)))
-    }
-
-    /// [`write_to`](Self::write_to) into `$OUT_DIR/file_name`, for a build script; returns the
-    /// path written. The crate then says `include!(concat!(env!("OUT_DIR"), "/FILE_NAME"));`.
-    ///
-    /// # Errors
-    /// As [`write_to`](Self::write_to), or `OUT_DIR` is not set (not running under Cargo as a
-    /// build script).
-    pub fn write_to_out_dir(
-        &self,
-        file_name: &str,
-        options: &CodegenOptions,
-    ) -> Result<PathBuf, WriteError> {
-        let out_dir = std::env::var_os("OUT_DIR").ok_or(WriteError::NoOutDir)?;
-        let path = Path::new(&out_dir).join(file_name);
-        self.write_to(&path, options)?;
-        Ok(path)
+        let options = crate::Options {
+            limits: crate::Limits::UNBOUNDED_SIZE,
+            codegen: *options,
+        };
+        crate::expand(crate::Input::Text(&self.build()?), &options)
     }
 
     /// Records `text` as the next statement.
@@ -621,72 +491,6 @@ impl SceneBuilder {
     }
 }
 
-/// Generated tokens as source text, one statement or brace per line: what
-/// [`SceneBuilder::write_to`] writes. Linear in the size of the code, unlike formatting.
-///
-/// Why not `TokenStream::to_string()`: it puts everything on one line, and rustc's cost of
-/// locating a span (every bounds check's panic location) grows with the length of its line, so
-/// a multi-megabyte line makes the including crate's release build several times slower
-/// (measured: 22 s against 4 s for a 600 kB scene).
-pub fn source_text(tokens: TokenStream) -> String {
-    let mut text = String::new();
-    // Iterative: generated code nests shallowly, but this must not recurse on its input anyway.
-    // Each open group: its tokens, its delimiter, and whether it is an attribute (`#[…]`, which
-    // ends its line: doc comments come in long runs).
-    let mut stack = vec![(tokens.into_iter(), Delimiter::None, false)];
-    while let Some((iter, delimiter, attribute)) = stack.last_mut() {
-        let (delimiter, attribute) = (*delimiter, *attribute);
-        match iter.next() {
-            None => {
-                stack.pop();
-                match delimiter {
-                    Delimiter::Brace => text.push_str("}\n"),
-                    Delimiter::Parenthesis => text.push_str(") "),
-                    Delimiter::Bracket if attribute => text.push_str("]\n"),
-                    Delimiter::Bracket => text.push_str("] "),
-                    Delimiter::None => {}
-                }
-            }
-            Some(TokenTree::Group(group)) => {
-                let attribute = text.ends_with("# ") || text.ends_with('#');
-                match group.delimiter() {
-                    Delimiter::Brace => text.push_str("{\n"),
-                    Delimiter::Parenthesis => text.push('('),
-                    Delimiter::Bracket => text.push('['),
-                    Delimiter::None => {}
-                }
-                stack.push((group.stream().into_iter(), group.delimiter(), attribute));
-            }
-            Some(TokenTree::Punct(punct)) => {
-                text.push(punct.as_char());
-                match (punct.spacing(), punct.as_char()) {
-                    // Joint: part of `::`, `->`, `'a`, …; no space inside.
-                    (Spacing::Joint, _) => {}
-                    // A statement's end, but not `[T; N]`.
-                    (Spacing::Alone, ';') if delimiter != Delimiter::Bracket => text.push('\n'),
-                    // Long lists (the Jacobian's pattern, the coordinate names) wrap.
-                    (Spacing::Alone, ',') if text.len() - line_start(&text) > 100 => {
-                        text.push('\n');
-                    }
-                    (Spacing::Alone, _) => text.push(' '),
-                }
-            }
-            Some(TokenTree::Ident(ident)) => {
-                let _ = write!(text, "{ident} ");
-            }
-            Some(TokenTree::Literal(literal)) => {
-                let _ = write!(text, "{literal} ");
-            }
-        }
-    }
-    text
-}
-
-/// Byte offset at which the last line of `text` starts.
-fn line_start(text: &str) -> usize {
-    text.rfind('\n').map_or(0, |i| i + 1)
-}
-
 /// `source` checked as one expression of the grammar and re-rendered from its tokens, so that a
 /// comment in it cannot swallow the rest of the statement.
 fn expression(source: &str) -> Result<String, String> {
@@ -695,8 +499,8 @@ fn expression(source: &str) -> Result<String, String> {
         return Err("empty; write a number or an expression".to_owned());
     }
     // The size limits first: the expression parser recurses on nesting.
-    crate::limits::check(&tokens).map_err(|e| e.to_string())?;
-    syn::parse2::<crate::spec::Expr>(tokens.clone()).map_err(|e| e.to_string())?;
+    crate::syntax::limits::check(&tokens).map_err(|e| e.to_string())?;
+    syn::parse2::<crate::syntax::spec::Expr>(tokens.clone()).map_err(|e| e.to_string())?;
     Ok(tokens.to_string())
 }
 
@@ -710,69 +514,6 @@ fn doc_lines(text: &str) -> impl Iterator<Item = String> + '_ {
             format!(" {line}")
         }
     })
-}
-
-/// The file written for `include!`: a plain (not inner-doc) header comment, which `include!`
-/// accepts, then the items.
-fn generated_file(code: &str) -> String {
-    format!("// Generated by mechgen::builder: do not edit.\n{code}\n")
-}
-
-fn write_if_changed(path: &Path, contents: &str) -> Result<(), WriteError> {
-    if std::fs::read(path).is_ok_and(|old| old == contents.as_bytes()) {
-        return Ok(());
-    }
-    std::fs::write(path, contents).map_err(|source| WriteError::Io {
-        path: path.to_owned(),
-        source,
-    })
-}
-
-/// Why [`SceneBuilder::write_to`] (or `write_to_out_dir`) failed.
-#[derive(Debug)]
-pub enum WriteError {
-    /// The scene has errors.
-    Scene(Errors),
-    /// The file could not be written.
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// What went wrong.
-        source: std::io::Error,
-    },
-    /// `OUT_DIR` is not set: `write_to_out_dir` is meant for a build script run by Cargo.
-    NoOutDir,
-}
-
-impl std::fmt::Display for WriteError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            WriteError::Scene(errors) => write!(f, "{errors}"),
-            WriteError::Io { path, source } => {
-                write!(f, "cannot write {}: {source}", path.display())
-            }
-            WriteError::NoOutDir => f.write_str(
-                "OUT_DIR is not set: `write_to_out_dir` is for build scripts run by Cargo; \
-                 use `write_to` with an explicit path elsewhere",
-            ),
-        }
-    }
-}
-
-impl std::error::Error for WriteError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            WriteError::Scene(errors) => Some(errors),
-            WriteError::Io { source, .. } => Some(source),
-            WriteError::NoOutDir => None,
-        }
-    }
-}
-
-impl From<Errors> for WriteError {
-    fn from(errors: Errors) -> Self {
-        WriteError::Scene(errors)
-    }
 }
 
 #[cfg(test)]
@@ -812,7 +553,8 @@ mod tests {
             text.contains("driver spin: angle(crank) = omega * t;"),
             "{text}"
         );
-        let scene = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let scene = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
         assert_eq!(scene.model.dim(), 12);
         let code = slider_crank()
             .expand(&CodegenOptions::default())
@@ -852,7 +594,8 @@ mod tests {
             text.contains("branch up: cross(frame -> crank @ (0.5, 0.0), frame -> slider) < 0;"),
             "{text}"
         );
-        let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let compiled = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
         assert_eq!(compiled.model.branches.len(), 2);
         assert_eq!(compiled.kinematics.branches.len(), 2);
         let mut bad = slider_crank();
@@ -900,7 +643,8 @@ mod tests {
         assert!(text.contains(
             "load coil: spring(frame, weight, stiffness 10.0, length 2.0, damping 0.5);"
         ));
-        let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let compiled = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
         assert_eq!(compiled.model.outputs, crate::model::Outputs::Forces);
         assert_eq!(compiled.model.loads.len(), 4);
         assert!(compiled.forces.is_some());
@@ -920,7 +664,8 @@ mod tests {
             scene.outputs(outputs);
             let text = scene.build().unwrap_or_else(|e| panic!("{e}"));
             assert!(text.contains(line), "{text}");
-            let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+            let compiled = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+                .unwrap_or_else(|e| panic!("{e}\n{text}"));
             assert_eq!(compiled.model.outputs, outputs);
         }
     }
@@ -951,7 +696,8 @@ mod tests {
         scene.revolute("pin", "frame", "b");
         scene.driver_angle("d", "b", "t");
         let text = scene.build().unwrap_or_else(|e| panic!("{e}"));
-        let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let compiled = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
         for (param, &x) in compiled.model.params.iter().zip(&values) {
             // Bit-exact, except that the checker folds `-0.0` to `0.0` (equal as numbers).
             assert!(param.default == x && (x == 0.0 || param.default.to_bits() == x.to_bits()));
@@ -970,16 +716,17 @@ mod tests {
         scene.revolute("pin", "frame", ("b1", [0.0, 0.0]));
         scene.driver_angle("d", "b1", "c * t");
         let text = scene.build().unwrap_or_else(|e| panic!("{e}"));
-        let compiled = crate::compile_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let compiled = crate::compile(crate::Input::Text(&text), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}\n{text}"));
         let model = &compiled.model;
         assert_eq!(model.params.len(), 2);
         assert_eq!(model.derived.len(), 1);
-        let env = crate::interpret::Env {
+        let env = crate::expr::tape::Env {
             params: vec![3.0, 4.0],
             ..Default::default()
         };
         assert_eq!(
-            crate::interpret::eval(&model.arena, model.derived[0].value, &env),
+            crate::expr::tape::eval(&model.arena, model.derived[0].value, &env),
             5.0
         );
     }

@@ -17,9 +17,9 @@
 
 use std::collections::HashMap;
 
-use crate::diff::Differentiator;
+use crate::expr::diff::Differentiator;
 use crate::expr::{Arena, Func, Id, Var, var_index};
-use crate::frames::{Frames, ground_poses};
+use crate::model::frames::{Frames, ground_poses};
 use crate::model::{LoadKind, Model, Point};
 
 /// The pull of the springs anchored to ground bodies on those bodies' coordinates (zero
@@ -275,10 +275,11 @@ impl Work<'_> {
 
 #[cfg(test)]
 mod tests {
-    use crate::interpret::{Env, eval};
+    use crate::expr::tape::{Env, eval};
 
     fn forces(source: &str, env: &Env) -> Vec<f64> {
-        let scene = crate::compile_str(source).unwrap_or_else(|e| panic!("{e}"));
+        let scene = crate::compile(crate::Input::Text(source), &crate::Options::default())
+            .unwrap_or_else(|e| panic!("{e}"));
         let mut model = scene.model;
         let forces = super::derive(&mut model);
         forces.iter().map(|&f| eval(&model.arena, f, env)).collect()

@@ -3,13 +3,13 @@
 //! The grammar (the reference below is `docs/grammar.md`, also on the `mechanism!` macro and
 //! the runtime's front page). Only syntax is checked here; `check` does the rest.
 //!
-#![doc = include_str!("../../docs/grammar.md")]
+#![doc = include_str!("../../../docs/grammar.md")]
 
 use proc_macro2::TokenStream;
 use syn::parse::{Parse, ParseStream};
 use syn::{Attribute, Ident, LitFloat, LitInt, Token, Visibility, braced, parenthesized};
 
-use crate::spec::{
+use crate::syntax::spec::{
     BinOp, BodyDecl, BranchDecl, DriverDecl, DriverKind, Expr, ExprKind, GravityDecl, JointDecl,
     JointKind, LoadDecl, LoadKind, MarkerDecl, MarkerKind, MassDecl, ParamDecl, PointDecl,
     PointRef, Product, Sign, Spec,
@@ -45,7 +45,7 @@ mod kw {
 /// # Errors
 /// Input beyond the size limits (`limits`), or the first syntax error, at its tokens.
 pub fn parse_tokens(tokens: TokenStream) -> syn::Result<Spec> {
-    crate::limits::check(&tokens)?;
+    crate::syntax::limits::check(&tokens)?;
     syn::parse2(tokens)
 }
 
@@ -115,6 +115,7 @@ fn doc_attributes(input: ParseStream) -> syn::Result<Vec<Attribute>> {
 
 /// One `;`-terminated statement of the body, added to `spec`.
 pub(crate) fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> {
+    // Whole: one arm per statement keyword of the grammar, each a few lines.
     let docs = doc_attributes(input)?;
     let look = input.lookahead1();
     if look.peek(kw::param) {
@@ -128,36 +129,7 @@ pub(crate) fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> 
             default,
         });
     } else if look.peek(kw::ground) || look.peek(kw::body) {
-        let ground = input.peek(kw::ground);
-        let keyword = input.span();
-        if ground {
-            input.parse::<kw::ground>()?;
-        } else {
-            input.parse::<kw::body>()?;
-        }
-        let name = input.parse()?;
-        if ground {
-            input.parse::<kw::at>().map_err(|e| {
-                syn::Error::new(
-                    e.span(),
-                    "expected `at (x, y, angle)`: the ground body's pose",
-                )
-            })?;
-        } else {
-            input.parse::<kw::near>().map_err(|e| {
-                syn::Error::new(e.span(), "expected `near (x, y, angle)`: an initial guess")
-            })?;
-        }
-        let (pose, _) = tuple::<3>(input, "(x, y, angle)")?;
-        let mass = mass_clause(input)?;
-        spec.bodies.push(BodyDecl {
-            docs,
-            keyword,
-            name,
-            ground,
-            pose,
-            mass,
-        });
+        spec.bodies.push(body(input, docs)?);
     } else if look.peek(kw::joint) {
         input.parse::<kw::joint>()?;
         let name = input.parse()?;
@@ -216,34 +188,7 @@ pub(crate) fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> 
         input.parse::<kw::marker>()?;
         let name = input.parse()?;
         input.parse::<Token![:]>()?;
-        // `angle(a, b)` is a sensor; anything else a point (a body named `angle` still works
-        // as `angle @ (x, y)` or `angle` alone).
-        let kind = if input.peek(Ident) && input.peek2(syn::token::Paren) {
-            let kind: Ident = input.parse()?;
-            if kind != "angle" {
-                return Err(syn::Error::new(
-                    kind.span(),
-                    format!(
-                        "unknown marker `{kind}(…)`; a marker tracks a point, `marker NAME: \
-                         body @ (x, y);`, or an angle between two bodies, `marker NAME: \
-                         angle(a, b);`"
-                    ),
-                ));
-            }
-            let args;
-            parenthesized!(args in input);
-            let a = args.parse()?;
-            args.parse::<Token![,]>()?;
-            let b = args.parse()?;
-            if !args.is_empty() {
-                return Err(
-                    args.error("unexpected argument: `angle` takes two bodies: `angle(a, b)`")
-                );
-            }
-            MarkerKind::Angle(a, b)
-        } else {
-            MarkerKind::Point(input.parse()?)
-        };
+        let kind = marker_kind(input)?;
         spec.markers.push(MarkerDecl { docs, name, kind });
     } else if look.peek(kw::point) {
         input.parse::<kw::point>()?;
@@ -267,6 +212,70 @@ pub(crate) fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> 
     }
     input.parse::<Token![;]>()?;
     Ok(())
+}
+
+/// `ground NAME at (x, y, angle)` or `body NAME near (x, y, angle)`, then its mass clause.
+fn body(input: ParseStream, docs: Vec<Attribute>) -> syn::Result<BodyDecl> {
+    let ground = input.peek(kw::ground);
+    let keyword = input.span();
+    if ground {
+        input.parse::<kw::ground>()?;
+    } else {
+        input.parse::<kw::body>()?;
+    }
+    let name = input.parse()?;
+    if ground {
+        input.parse::<kw::at>().map_err(|e| {
+            syn::Error::new(
+                e.span(),
+                "expected `at (x, y, angle)`: the ground body's pose",
+            )
+        })?;
+    } else {
+        input.parse::<kw::near>().map_err(|e| {
+            syn::Error::new(e.span(), "expected `near (x, y, angle)`: an initial guess")
+        })?;
+    }
+    let (pose, _) = tuple::<3>(input, "(x, y, angle)")?;
+    let mass = mass_clause(input)?;
+    Ok(BodyDecl {
+        docs,
+        keyword,
+        name,
+        ground,
+        pose,
+        mass,
+    })
+}
+
+/// A marker's kind (after `marker NAME:`): `angle(a, b)` or a point.
+fn marker_kind(input: ParseStream) -> syn::Result<MarkerKind> {
+    // `angle(a, b)` is a sensor; anything else a point (a body named `angle` still works
+    // as `angle @ (x, y)` or `angle` alone).
+    if input.peek(Ident) && input.peek2(syn::token::Paren) {
+        let kind: Ident = input.parse()?;
+        if kind != "angle" {
+            return Err(syn::Error::new(
+                kind.span(),
+                format!(
+                    "unknown marker `{kind}(…)`; a marker tracks a point, `marker NAME: \
+                     body @ (x, y);`, or an angle between two bodies, `marker NAME: \
+                     angle(a, b);`"
+                ),
+            ));
+        }
+        let args;
+        parenthesized!(args in input);
+        let a = args.parse()?;
+        args.parse::<Token![,]>()?;
+        let b = args.parse()?;
+        if !args.is_empty() {
+            return Err(args.error("unexpected argument: `angle` takes two bodies: `angle(a, b)`"));
+        }
+        Ok(MarkerKind::Angle(a, b))
+    } else {
+        Ok(MarkerKind::Point(input.parse()?))
+    }
 }
 
 /// `cross(p1 -> p2, p3 -> p4) > 0` (after `branch NAME:`); the right-hand side is parsed as an
@@ -345,7 +354,9 @@ const JOINT_KINDS: &str = "`revolute(a @ (x, y), b @ (x, y))`, `prismatic(a, b, 
      `weld(a @ (x, y), b @ (x, y))`, `gear(a, b, ratio k[, carrier c])` or \
      `rack(prismatic_joint, pinion, ratio r)`";
 
+/// A joint's kind and arguments (after `joint NAME:`).
 fn joint_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, JointKind)> {
+    // Whole: one arm per joint kind of the grammar.
     let kind: Ident = input.parse()?;
     let args;
     parenthesized!(args in input);
@@ -353,35 +364,7 @@ fn joint_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, JointKind)>
     args.parse::<Token![,]>()?;
     let b: PointRef = args.parse()?;
     let name = kind.to_string();
-    let usage = match name.as_str() {
-        "revolute" => "`revolute` joins two points: `revolute(a @ (x, y), b @ (x, y))`",
-        "prismatic" => {
-            "`prismatic` takes two bodies and an axis: `prismatic(a, b, along (ux, uy))`"
-        }
-        "distance" => "`distance` takes two points and a length: `distance(a @ (x, y), b, length)`",
-        "slot" => {
-            "`slot` takes a point on the slot, the pin and the slot's direction: \
-             `slot(a @ (x, y), b @ (x, y), along (ux, uy))`"
-        }
-        "weld" => {
-            "`weld` takes two points and optionally their relative angle: \
-             `weld(a @ (x, y), b @ (x, y), angle 30deg)`"
-        }
-        "gear" => {
-            "`gear` takes two bodies and their ratio, optionally a carrier and a phase: \
-             `gear(sun, planet, ratio -2, carrier arm, phase 0.1)`"
-        }
-        "rack" => {
-            "`rack` takes a prismatic joint, the pinion and the travel per radian: \
-             `rack(slide, pinion, ratio 20, phase 0)`"
-        }
-        other => {
-            return Err(syn::Error::new(
-                kind.span(),
-                format!("unknown joint kind `{other}`; expected {JOINT_KINDS}"),
-            ));
-        }
-    };
+    let usage = joint_usage(&kind)?;
     let joint = match name.as_str() {
         "revolute" => JointKind::Revolute { a, b },
         "prismatic" | "slot" => {
@@ -451,6 +434,41 @@ fn joint_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, JointKind)>
         return Err(args.error(format!("unexpected argument: {usage}")));
     }
     Ok((kind.span(), joint))
+}
+
+/// How a joint of kind `kind` is written, for its error messages; an error for an unknown
+/// kind.
+fn joint_usage(kind: &Ident) -> syn::Result<&'static str> {
+    let usage = match kind.to_string().as_str() {
+        "revolute" => "`revolute` joins two points: `revolute(a @ (x, y), b @ (x, y))`",
+        "prismatic" => {
+            "`prismatic` takes two bodies and an axis: `prismatic(a, b, along (ux, uy))`"
+        }
+        "distance" => "`distance` takes two points and a length: `distance(a @ (x, y), b, length)`",
+        "slot" => {
+            "`slot` takes a point on the slot, the pin and the slot's direction: \
+             `slot(a @ (x, y), b @ (x, y), along (ux, uy))`"
+        }
+        "weld" => {
+            "`weld` takes two points and optionally their relative angle: \
+             `weld(a @ (x, y), b @ (x, y), angle 30deg)`"
+        }
+        "gear" => {
+            "`gear` takes two bodies and their ratio, optionally a carrier and a phase: \
+             `gear(sun, planet, ratio -2, carrier arm, phase 0.1)`"
+        }
+        "rack" => {
+            "`rack` takes a prismatic joint, the pinion and the travel per radian: \
+             `rack(slide, pinion, ratio 20, phase 0)`"
+        }
+        other => {
+            return Err(syn::Error::new(
+                kind.span(),
+                format!("unknown joint kind `{other}`; expected {JOINT_KINDS}"),
+            ));
+        }
+    };
+    Ok(usage)
 }
 
 /// `along (ux, uy)`: an axis in the first body's frame.
@@ -563,30 +581,33 @@ fn driver_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, DriverKind
         }
     };
     if !args.is_empty() {
-        let advice = match driver {
-            DriverKind::Angle(_) => {
-                "`angle` drives one body's absolute angle; to drive the angle between two \
-                 bodies, write `relative_angle(a, b)`"
-            }
-            DriverKind::X(_) | DriverKind::Y(_) => {
-                "`x` and `y` drive one point's global coordinate: `x(body @ (px, py))`"
-            }
-            DriverKind::Travel(_) => {
-                "`travel` takes the name of one prismatic joint: `travel(slide)`"
-            }
-            DriverKind::RelativeAngle(..) => {
-                "`relative_angle` takes two bodies: `relative_angle(a, b)`"
-            }
-            DriverKind::Distance(..) => {
-                "`distance` takes two points: `distance(a @ (x, y), b @ (x, y))`"
-            }
-            DriverKind::Slide { .. } => {
-                "`slide` takes two points and an axis: `slide(a @ (x, y), b, along (ux, uy))`"
-            }
-        };
+        let advice = driver_usage(&driver);
         return Err(args.error(format!("unexpected argument: {advice}")));
     }
     Ok((kind.span(), driver))
+}
+
+/// How a driver of `driver`'s kind is written, for an error about its arguments.
+fn driver_usage(driver: &DriverKind) -> &'static str {
+    match driver {
+        DriverKind::Angle(_) => {
+            "`angle` drives one body's absolute angle; to drive the angle between two \
+             bodies, write `relative_angle(a, b)`"
+        }
+        DriverKind::X(_) | DriverKind::Y(_) => {
+            "`x` and `y` drive one point's global coordinate: `x(body @ (px, py))`"
+        }
+        DriverKind::Travel(_) => "`travel` takes the name of one prismatic joint: `travel(slide)`",
+        DriverKind::RelativeAngle(..) => {
+            "`relative_angle` takes two bodies: `relative_angle(a, b)`"
+        }
+        DriverKind::Distance(..) => {
+            "`distance` takes two points: `distance(a @ (x, y), b @ (x, y))`"
+        }
+        DriverKind::Slide { .. } => {
+            "`slide` takes two points and an axis: `slide(a @ (x, y), b, along (ux, uy))`"
+        }
+    }
 }
 
 /// `mass m`, `inertia J` and `centre (x, y)` after a body's pose, in any order, each at most
@@ -665,44 +686,7 @@ fn load_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, LoadKind)> {
                 value: input.parse()?,
             }
         }
-        "spring" => {
-            let a = args.parse()?;
-            args.parse::<Token![,]>()?;
-            let b = args.parse()?;
-            let (mut stiffness, mut length, mut damping) = (None, None, None);
-            while !args.is_empty() {
-                args.parse::<Token![,]>()?;
-                let span = args.span();
-                let slot = if args.peek(kw::stiffness) {
-                    args.parse::<kw::stiffness>()?;
-                    &mut stiffness
-                } else if args.peek(kw::length) {
-                    args.parse::<kw::length>()?;
-                    &mut length
-                } else if args.peek(kw::damping) {
-                    args.parse::<kw::damping>()?;
-                    &mut damping
-                } else {
-                    return Err(args.error(
-                        "expected `stiffness k`, `length L` or `damping c`, as in \
-                         `spring(a @ (x, y), b, stiffness 20, length 35, damping 0.1)`",
-                    ));
-                };
-                if slot.replace(args.parse()?).is_some() {
-                    return Err(syn::Error::new(
-                        span,
-                        "this spring argument is given twice; keep one",
-                    ));
-                }
-            }
-            LoadKind::Spring {
-                a,
-                b,
-                stiffness,
-                length,
-                damping,
-            }
-        }
+        "spring" => spring(&args)?,
         other => {
             return Err(syn::Error::new(
                 kind.span(),
@@ -715,6 +699,47 @@ fn load_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, LoadKind)> {
         }
     };
     Ok((kind.span(), load))
+}
+
+/// `spring(p, q, stiffness k, length L, damping c)`'s arguments, the keywords in any order,
+/// each at most once.
+fn spring(args: ParseStream) -> syn::Result<LoadKind> {
+    let a = args.parse()?;
+    args.parse::<Token![,]>()?;
+    let b = args.parse()?;
+    let (mut stiffness, mut length, mut damping) = (None, None, None);
+    while !args.is_empty() {
+        args.parse::<Token![,]>()?;
+        let span = args.span();
+        let slot = if args.peek(kw::stiffness) {
+            args.parse::<kw::stiffness>()?;
+            &mut stiffness
+        } else if args.peek(kw::length) {
+            args.parse::<kw::length>()?;
+            &mut length
+        } else if args.peek(kw::damping) {
+            args.parse::<kw::damping>()?;
+            &mut damping
+        } else {
+            return Err(args.error(
+                "expected `stiffness k`, `length L` or `damping c`, as in \
+                 `spring(a @ (x, y), b, stiffness 20, length 35, damping 0.1)`",
+            ));
+        };
+        if slot.replace(args.parse()?).is_some() {
+            return Err(syn::Error::new(
+                span,
+                "this spring argument is given twice; keep one",
+            ));
+        }
+    }
+    Ok(LoadKind::Spring {
+        a,
+        b,
+        stiffness,
+        length,
+        damping,
+    })
 }
 
 impl Parse for PointRef {
@@ -953,7 +978,7 @@ fn number(digits: &str, suffix: &str, span: proc_macro2::Span) -> syn::Result<Ex
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::source::parse_str;
+    use crate::syntax::source::parse_str;
 
     fn show(e: &Expr) -> String {
         match &e.kind {

@@ -1,0 +1,12 @@
+//! Planning the solve, once per scene at generation time: the stages that decide the
+//! coordinates ([`structure`]), the force solve that runs them in reverse ([`reactions`]), the
+//! planned [`Scene`] that the emitter and the interpreter read, and its operation counts
+//! ([`stats`]).
+
+pub mod kernels;
+pub mod reactions;
+pub mod scene;
+pub mod stats;
+pub mod structure;
+
+pub use scene::Scene;
