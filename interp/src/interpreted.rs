@@ -16,12 +16,13 @@ use mechgen::kinematics::LengthScale;
 use mechgen::reactions::ForceStage;
 use mechgen::structure::{self, Phase, Plan};
 use mechgen::{geometry, physics};
-use mechgen_runtime::first_load_fault;
+use mechgen_runtime::codegen::{
+    Block, Pattern, Stage, VecBuffers, check_physics, first_load_fault,
+};
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{
-    Accelerations, Block, Forces, GeometryFault, Matrix, Mechanism, Names, Outputs, ParameterError,
-    Pattern, PhysicsFault, Quantity, Requirement, Stage, Structured, Subject, Unit, VecBuffers,
-    Vector, Velocities, check_physics,
+    Accelerations, Forces, GeometryFault, Matrix, Mechanism, Names, Outputs, ParameterError,
+    PhysicsFault, Quantity, Requirement, Structured, Subject, Unit, Vector, Velocities,
 };
 
 /// A scene whose kinematics are interpreted rather than generated.
@@ -576,7 +577,7 @@ impl Mechanism for Interpreted {
         }
         self.run(&self.geometry_values, self.inputs(&[], &[], 0.0), |v| {
             result = self.geometry.iter().zip(v).try_for_each(|(c, &value)| {
-                mechgen_runtime::check_geometry(
+                mechgen_runtime::codegen::check_geometry(
                     value,
                     requirement(c.requirement),
                     c.equation,

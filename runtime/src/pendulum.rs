@@ -7,7 +7,7 @@
 
 use nalgebra::Const;
 
-use crate::math::{cos, sin};
+use crate::codegen::math::{cos, sin};
 use crate::mechanism::{
     Accelerations, Forces, Matrix, Mechanism, Outputs, ParameterError, Unit, Vector, Velocities,
 };

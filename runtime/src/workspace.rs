@@ -8,7 +8,7 @@
 //! coordinates, largest block 6) needs 90 kB, where one dense Jacobian would need 289 MB.
 
 /// Storage the solver borrows for one solve. Implemented by [`Buffers`] (inline arrays, for
-/// generated scenes), [`crate::DenseBuffers`] (the dense reference) and, with the `alloc`
+/// generated scenes), [`crate::codegen::DenseBuffers`] (the dense reference) and, with the `alloc`
 /// feature, `VecBuffers` (the interpreter); the solver is its only user.
 pub trait Workspace {
     /// Every buffer at once, as disjoint slices.

@@ -442,7 +442,7 @@ impl Context<'_> {
             TokenStream::new()
         } else {
             let funcs = funcs.iter().map(|f| format_ident!("{}", f));
-            quote! { use ::mechgen_runtime::math::{#(#funcs),*}; }
+            quote! { use ::mechgen_runtime::codegen::math::{#(#funcs),*}; }
         };
         loads.sort_by_key(|(v, _)| *v);
         trig_loads.sort_by_key(|(i, _)| *i);

@@ -33,7 +33,7 @@ impl Context<'_> {
             };
             let parameter = idx(c.parameter);
             quote! {
-                ::mechgen_runtime::check_physics(
+                ::mechgen_runtime::codegen::check_physics(
                     #name,
                     ::mechgen_runtime::Requirement::#requirement,
                     #subject,

@@ -204,17 +204,17 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan) -> TokenStream {
         }
 
         impl ::mechgen_runtime::Structured for #name {
-            type Workspace = ::mechgen_runtime::Buffers<#b, #s, #k, #n, #trig_len #forces>;
+            type Workspace = ::mechgen_runtime::codegen::Buffers<#b, #s, #k, #n, #trig_len #forces>;
 
             fn workspace(&self) -> Self::Workspace {
-                ::mechgen_runtime::Buffers::new()
+                ::mechgen_runtime::codegen::Buffers::new()
             }
 
             fn stage_count(&self) -> usize {
                 #stage_count
             }
 
-            fn stage(&self, index: usize) -> ::core::option::Option<::mechgen_runtime::Stage<'_>> {
+            fn stage(&self, index: usize) -> ::core::option::Option<::mechgen_runtime::codegen::Stage<'_>> {
                 Self::STAGES.get(index).copied()
             }
 
@@ -414,7 +414,7 @@ fn stage_table(model: &Model, plan: &Plan) -> TokenStream {
                 let coords: Vec<usize> = assignments.iter().map(|a| a.coordinate).collect();
                 let (e, c, r) = (list(&eqs), list(&coords), list(&plan.reads[s]));
                 quote! {
-                    ::mechgen_runtime::Stage::Explicit { equations: #e, coordinates: #c, reads: #r }
+                    ::mechgen_runtime::codegen::Stage::Explicit { equations: #e, coordinates: #c, reads: #r }
                 }
             }
             Stage::Block(block) => {
@@ -431,10 +431,10 @@ fn stage_table(model: &Model, plan: &Plan) -> TokenStream {
                 let pivots = block.factorization.as_ref().map(Factorization::pivots);
                 let pivots = list(&pivots.unwrap_or_default());
                 quote! {
-                    ::mechgen_runtime::Stage::Block(::mechgen_runtime::Block {
+                    ::mechgen_runtime::codegen::Stage::Block(::mechgen_runtime::codegen::Block {
                         equations: #e,
                         coordinates: #c,
-                        pattern: ::mechgen_runtime::Pattern::Sparse(&[#(#pattern),*]),
+                        pattern: ::mechgen_runtime::codegen::Pattern::Sparse(&[#(#pattern),*]),
                         slots: #slots,
                         pivots: #pivots,
                         reads: #reads,
@@ -447,7 +447,7 @@ fn stage_table(model: &Model, plan: &Plan) -> TokenStream {
     let count = idx(entries.len());
     quote! {
         #(#[doc = #docs])*
-        pub const STAGES: [::mechgen_runtime::Stage<'static>; #count] = [#(#entries),*];
+        pub const STAGES: [::mechgen_runtime::codegen::Stage<'static>; #count] = [#(#entries),*];
     }
 }
 

@@ -4,7 +4,7 @@
 //! `r` to the slider at distance `l`, and the slider runs along the x-axis. Every body's
 //! reference point is at the joint it hangs from: crank at the pivot, rod at the crank pin.
 
-use mechgen_runtime::math::{cos, sin};
+use mechgen_runtime::codegen::math::{cos, sin};
 use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{
     Accelerations, Dense, Matrix, Mechanism, Outputs, ParameterError, Unit, Vector, Velocities,
