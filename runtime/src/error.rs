@@ -499,6 +499,7 @@ impl SolveError {
     }
 
     fn write(&self, f: &mut fmt::Formatter<'_>, names: &dyn Lookup) -> fmt::Result {
+        // Kept whole: one arm per variant, so that each message reads in one place.
         let equation =
             |f: &mut fmt::Formatter<'_>, index: usize| write_name(f, names.equation(index), index);
         match *self {
@@ -794,6 +795,7 @@ mod tests {
     /// One error of every variant (and every quantity that has an index), each with the
     /// names it must show.
     fn every_error() -> Vec<(SolveError, &'static [&'static str])> {
+        // Kept whole: a table, one error per variant and per indexed quantity.
         let names = &Names::NONE;
         let non_finite = |quantity, equation| SolveError::NonFinite {
             time: 0.5,

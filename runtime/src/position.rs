@@ -155,6 +155,7 @@ where
         q: &mut Vector<M::Dim>,
         factors_needed: bool,
     ) -> Result<Solved, SolveError> {
+        // Kept whole: one Newton loop; its phases share the pending step and the last correction.
         let options = *self.options;
         // A looser residual tolerance asked for loosens acceptance with it.
         let acceptance = options.acceptance_tolerance.max(options.residual_tolerance);
@@ -173,15 +174,7 @@ where
             let magnitude = self.magnitude(q);
             let small = residual <= options.residual_tolerance * magnitude;
             if finishing {
-                // Acceptance is absolute: a step test relative to large coordinates (an angle
-                // of 1e12 rad) must not accept a residual of their rounding.
-                if residual > acceptance {
-                    return Err(self.unresolved(iterations));
-                }
-                return match factored {
-                    Ok(factors) => self.finish(q, factors, iterations),
-                    Err(error) => Err(self.factor_error(q, error)),
-                };
+                return self.finish_evaluated(q, factored, residual, acceptance, iterations);
             }
             if let Some((base_merit, fraction)) = pending.take() {
                 let enough = merit <= (1.0 - SUFFICIENT_DECREASE * fraction) * base_merit;
@@ -213,20 +206,7 @@ where
                 return Err(self.give_up(q, factors, iterations, residual, &marquardt));
             }
 
-            // step ← J⁻¹ Φ = −Δq.
-            let n = self.bs.n();
-            let newton = &mut self.parts.newton;
-            newton.step[..n].copy_from_slice(&newton.phi[..n]);
-            self.bs.solve(
-                factors,
-                &self.parts.factors,
-                &self.parts.scales,
-                self.parts.newton.step,
-            );
-            let length = scaled_max(&self.parts.newton.step[..n], self.parts.scales.inverse_cols);
-            if !length.is_finite() {
-                return Err(non_finite(self.t, Quantity::Step));
-            }
+            let length = self.newton_step(factors)?;
             let fraction = if length > options.max_step {
                 options.max_step / length
             } else {
@@ -256,6 +236,50 @@ where
                 finishing = true;
             }
         }
+    }
+
+    /// The end of a solve whose last correction was not negligible: the positions it returned
+    /// were evaluated (`factored`, with ‖D_r Φ_b‖∞ = `residual`), and are accepted with these
+    /// factors if the residual is within `acceptance`.
+    fn finish_evaluated(
+        &mut self,
+        q: &Vector<M::Dim>,
+        factored: Result<Factors, LuError>,
+        residual: f64,
+        acceptance: f64,
+        iterations: usize,
+    ) -> Result<Solved, SolveError> {
+        // Acceptance is absolute: a step test relative to large coordinates (an angle
+        // of 1e12 rad) must not accept a residual of their rounding.
+        if residual > acceptance {
+            return Err(self.unresolved(iterations));
+        }
+        match factored {
+            Ok(factors) => self.finish(q, factors, iterations),
+            Err(error) => Err(self.factor_error(q, error)),
+        }
+    }
+
+    /// The Newton step `step ← J⁻¹ Φ = −Δq` with `factors`, and its length ‖D_c⁻¹ step‖∞ in
+    /// scene lengths and radians.
+    ///
+    /// # Errors
+    /// [`SolveError::NonFinite`] for a non-finite step.
+    fn newton_step(&mut self, factors: Factors) -> Result<f64, SolveError> {
+        let n = self.bs.n();
+        let newton = &mut self.parts.newton;
+        newton.step[..n].copy_from_slice(&newton.phi[..n]);
+        self.bs.solve(
+            factors,
+            &self.parts.factors,
+            &self.parts.scales,
+            self.parts.newton.step,
+        );
+        let length = scaled_max(&self.parts.newton.step[..n], self.parts.scales.inverse_cols);
+        if !length.is_finite() {
+            return Err(non_finite(self.t, Quantity::Step));
+        }
+        Ok(length)
     }
 
     /// Evaluates Φ_b into `phi` and factors the scaled block Jacobian at `q`.
@@ -564,31 +588,11 @@ where
         iterations: &mut usize,
     ) -> Result<(), SolveError> {
         marquardt.used = true;
-        let n = self.bs.n();
         if *iterations >= self.options.max_iterations {
             self.residual_at(q)?;
             return Err(self.no_assembly(q, *iterations));
         }
-        // S = D_r J D_c into `dense`, Φ_b into `phi`.
-        {
-            let parts = &mut *self.parts;
-            let evaluated = self.bs.evaluate(
-                q,
-                parts.trig,
-                self.t,
-                parts.newton.phi,
-                parts.factors.values,
-                &parts.scales,
-                parts.estimator.x,
-            );
-            self.check_phi()?;
-            if evaluated.is_err() {
-                return Err(self.non_finite_jacobian(q));
-            }
-            let parts = &mut *self.parts;
-            self.bs
-                .scatter(parts.factors.values, &mut parts.dense[..n * n]);
-        }
+        self.evaluate_dense(q)?;
         let (merit, residual) = self.norms();
         if residual <= self.options.residual_tolerance {
             return Ok(());
@@ -611,65 +615,10 @@ where
         while marquardt.mu <= mu_limit && trials < MAX_DAMPING_TRIALS {
             trials += 1;
             let mu = marquardt.mu;
-            let parts = &mut *self.parts;
-            let (lu, swaps) = (
-                &mut parts.factors.lu[..n * n],
-                &mut parts.factors.swaps[..n],
-            );
-            normal_matrix(&parts.dense[..n * n], n, mu, lu);
-            let factored =
-                lu::factor_in_place(lu, swaps, self.options.pivot_tolerance, 0.0).is_ok();
-            let step = &mut parts.newton.step[..n];
-            if factored {
-                step.copy_from_slice(&parts.newton.gradient[..n]);
-                lu::solve_factors(lu, swaps, step);
-            }
-            // Trial point q_b = base − D_c δ (δ clamped), its Φ_b into `trial`.
-            let length = max_abs(step);
-            let fraction = if length > self.options.max_step {
-                self.options.max_step / length
-            } else {
-                1.0
-            };
-            let trial_merit = if factored && length.is_finite() {
-                let qs = q.as_mut_slice();
-                for (((&b, &s), &c), &j) in parts
-                    .newton
-                    .base
-                    .iter()
-                    .zip(step.iter())
-                    .zip(parts.scales.cols.iter())
-                    .zip(self.bs.block.coordinates)
-                {
-                    qs[j] = b - fraction * s * c;
-                }
-                self.bs.m.block_jacobian(
-                    self.bs.stage,
-                    q,
-                    parts.trig,
-                    self.t,
-                    &mut parts.newton.trial[..n],
-                    &mut parts.factors.values[..self.bs.block.slots],
-                );
-                scaled_norms(&parts.newton.trial[..n], parts.scales.rows).0
-            } else {
-                f64::INFINITY
-            };
+            let trial_merit = self.damped_trial(q, mu);
             if trial_merit < merit {
-                let newton = &mut self.parts.newton;
-                newton.phi[..n].copy_from_slice(&newton.trial[..n]);
-                *iterations += 1;
-                marquardt.mu = (mu / 3.0).max(1e-12 * largest);
                 let progress = 1.0 - trial_merit / merit;
-                marquardt.stalls = if progress < STALL_DECREASE {
-                    marquardt.stalls + 1
-                } else {
-                    0
-                };
-                if marquardt.stalls >= STALL_LIMIT {
-                    return Err(self.no_assembly(q, *iterations));
-                }
-                return Ok(());
+                return self.accept_damped(q, marquardt, iterations, mu, largest, progress);
             }
             self.restore(q);
             marquardt.mu = mu * 4.0;
@@ -687,6 +636,145 @@ where
         Err(self.no_assembly(q, *iterations))
     }
 
+    /// Takes the damped step (with damping `mu`) whose trial point is in `q` and its Φ_b in
+    /// `trial`: that Φ_b becomes `phi`, μ shrinks (to no less than 1e-12 of the largest
+    /// squared column norm `largest`), and a step whose relative `progress` is below
+    /// [`STALL_DECREASE`] counts towards a stall.
+    ///
+    /// # Errors
+    /// [`SolveError::NoAssembly`] after [`STALL_LIMIT`] stalled steps in a row.
+    fn accept_damped(
+        &mut self,
+        q: &Vector<M::Dim>,
+        marquardt: &mut Marquardt,
+        iterations: &mut usize,
+        mu: f64,
+        largest: f64,
+        progress: f64,
+    ) -> Result<(), SolveError> {
+        let n = self.bs.n();
+        let newton = &mut self.parts.newton;
+        newton.phi[..n].copy_from_slice(&newton.trial[..n]);
+        *iterations += 1;
+        marquardt.mu = (mu / 3.0).max(1e-12 * largest);
+        marquardt.stalls = if progress < STALL_DECREASE {
+            marquardt.stalls + 1
+        } else {
+            0
+        };
+        if marquardt.stalls >= STALL_LIMIT {
+            return Err(self.no_assembly(q, *iterations));
+        }
+        Ok(())
+    }
+
+    /// Φ_b at `q` into `phi` and the scaled Jacobian S = D_r J D_c into `dense`, for a
+    /// Levenberg–Marquardt step.
+    fn evaluate_dense(&mut self, q: &Vector<M::Dim>) -> Result<(), SolveError> {
+        let n = self.bs.n();
+        let parts = &mut *self.parts;
+        let evaluated = self.bs.evaluate(
+            q,
+            parts.trig,
+            self.t,
+            parts.newton.phi,
+            parts.factors.values,
+            &parts.scales,
+            parts.estimator.x,
+        );
+        self.check_phi()?;
+        if evaluated.is_err() {
+            return Err(self.non_finite_jacobian(q));
+        }
+        let parts = &mut *self.parts;
+        self.bs
+            .scatter(parts.factors.values, &mut parts.dense[..n * n]);
+        Ok(())
+    }
+
+    /// The merit ‖D_r Φ_b‖₂ at the trial point of a Levenberg–Marquardt step with damping
+    /// `mu` from `base` (S in `dense`, J_sᵀ Φ_s in `gradient`): q_b = base − D_c δ, δ clamped
+    /// to `max_step`, its Φ_b into `trial`. Infinite (and `q` untouched) when the damped system
+    /// cannot be factored or its step is not finite.
+    fn damped_trial(&mut self, q: &mut Vector<M::Dim>, mu: f64) -> f64 {
+        let n = self.bs.n();
+        let parts = &mut *self.parts;
+        let (lu, swaps) = (
+            &mut parts.factors.lu[..n * n],
+            &mut parts.factors.swaps[..n],
+        );
+        normal_matrix(&parts.dense[..n * n], n, mu, lu);
+        let factored = lu::factor_in_place(lu, swaps, self.options.pivot_tolerance, 0.0).is_ok();
+        let step = &mut parts.newton.step[..n];
+        if factored {
+            step.copy_from_slice(&parts.newton.gradient[..n]);
+            lu::solve_factors(lu, swaps, step);
+        }
+        // Trial point q_b = base − D_c δ (δ clamped), its Φ_b into `trial`.
+        let length = max_abs(step);
+        let fraction = if length > self.options.max_step {
+            self.options.max_step / length
+        } else {
+            1.0
+        };
+        if factored && length.is_finite() {
+            let qs = q.as_mut_slice();
+            for (((&b, &s), &c), &j) in parts
+                .newton
+                .base
+                .iter()
+                .zip(step.iter())
+                .zip(parts.scales.cols.iter())
+                .zip(self.bs.block.coordinates)
+            {
+                qs[j] = b - fraction * s * c;
+            }
+            self.bs.m.block_jacobian(
+                self.bs.stage,
+                q,
+                parts.trig,
+                self.t,
+                &mut parts.newton.trial[..n],
+                &mut parts.factors.values[..self.bs.block.slots],
+            );
+            scaled_norms(&parts.newton.trial[..n], parts.scales.rows).0
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The direction v that the scaled Jacobian S (in `dense`) maps closest to zero, into
+    /// `step`: inverse iteration on SᵀS + μI, μ tiny against the largest squared column norm
+    /// `largest`, v signed so that its largest component is positive. `false` when SᵀS + μI
+    /// cannot be factored or the iteration degenerates.
+    fn null_direction(&mut self, largest: f64) -> bool {
+        let n = self.bs.n();
+        let parts = &mut *self.parts;
+        let (lu, swaps) = (
+            &mut parts.factors.lu[..n * n],
+            &mut parts.factors.swaps[..n],
+        );
+        normal_matrix(&parts.dense[..n * n], n, 1e-10 * largest, lu);
+        if lu::factor_in_place(lu, swaps, 0.0, 0.0).is_err() {
+            return false;
+        }
+        let v = &mut parts.newton.step[..n];
+        v.fill(1.0);
+        for _ in 0..3 {
+            lu::solve_factors(lu, swaps, v);
+            let size = max_abs(v);
+            if !(size.is_finite() && size > 0.0) {
+                return false;
+            }
+            let sign = v
+                .iter()
+                .fold(0.0_f64, |m, x| if x.abs() > m.abs() { *x } else { m });
+            let norm = size.copysign(sign);
+            v.iter_mut().for_each(|x| *x /= norm);
+        }
+        true
+    }
+
     /// From a stationary point `q` (Φ_b in `phi`, scaled Jacobian S in `dense`) where the merit
     /// is `merit`: the direction v that S maps closest to zero (inverse iteration on
     /// SᵀS + μI, μ tiny against the largest squared column norm `largest`), signed so that its
@@ -701,30 +789,10 @@ where
         merit: f64,
         largest: f64,
     ) -> Result<bool, SolveError> {
-        let n = self.bs.n();
-        let parts = &mut *self.parts;
-        let (lu, swaps) = (
-            &mut parts.factors.lu[..n * n],
-            &mut parts.factors.swaps[..n],
-        );
-        normal_matrix(&parts.dense[..n * n], n, 1e-10 * largest, lu);
-        if lu::factor_in_place(lu, swaps, 0.0, 0.0).is_err() {
+        if !self.null_direction(largest) {
             return Ok(false);
         }
-        let v = &mut parts.newton.step[..n];
-        v.fill(1.0);
-        for _ in 0..3 {
-            lu::solve_factors(lu, swaps, v);
-            let size = max_abs(v);
-            if !(size.is_finite() && size > 0.0) {
-                return Ok(false);
-            }
-            let sign = v
-                .iter()
-                .fold(0.0_f64, |m, x| if x.abs() > m.abs() { *x } else { m });
-            let norm = size.copysign(sign);
-            v.iter_mut().for_each(|x| *x /= norm);
-        }
+        let n = self.bs.n();
         self.save_base(q);
         for sign in [self.escape_side, -self.escape_side] {
             let mut length = self.options.max_step;

@@ -257,16 +257,7 @@ where
                 Outcome::Crossed | Outcome::Failed(SolveError::BranchFlip { .. })
             );
             if crossed && finest {
-                outcome = match self.locate_crossing(target) {
-                    Ok(()) => {
-                        self.accept();
-                        Outcome::Solved
-                    }
-                    Err(error) => {
-                        self.states[self.newest].copy_from(&self.saved);
-                        return Err(error);
-                    }
-                };
+                outcome = self.settle_crossing(target)?;
             }
             match outcome {
                 Outcome::Solved => {
@@ -287,6 +278,24 @@ where
                 Outcome::Failed(_) | Outcome::Jumped | Outcome::Crossed => {
                     (h, successes) = (0.5 * h, 0);
                 }
+            }
+        }
+    }
+
+    /// A crossing at the finest sub-step to `target`, located and accepted; on failure the
+    /// state the step started from is restored.
+    ///
+    /// # Errors
+    /// [`Simulation::locate_crossing`]'s.
+    fn settle_crossing(&mut self, target: f64) -> Result<Outcome, SolveError> {
+        match self.locate_crossing(target) {
+            Ok(()) => {
+                self.accept();
+                Ok(Outcome::Solved)
+            }
+            Err(error) => {
+                self.states[self.newest].copy_from(&self.saved);
+                Err(error)
             }
         }
     }
@@ -380,6 +389,7 @@ pub(crate) fn predict<M: Mechanism>(
 where
     DefaultAllocator: Storage<M::Dim>,
 {
+    // Kept whole: one arm per output kind, each one Taylor formula over the coordinates.
     let h = t - current.t;
     let h_prev = current.t - next.t;
     let history = history && h_prev != 0.0 && h_prev.is_finite();

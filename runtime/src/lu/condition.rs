@@ -1,5 +1,7 @@
 //! The Hager–Higham estimate of `‖S⁻¹‖₁` (LAPACK `dlacn2`) from a few solves with `S` and `Sᵀ`.
 
+use core::ops::ControlFlow;
+
 /// Iteration limit of the 1-norm estimator, as LAPACK's `dlacn2` (`ITMAX`).
 const ESTIMATOR_ITERATIONS: usize = 5;
 
@@ -21,27 +23,10 @@ pub(crate) fn inverse_one_norm_estimate(
             signs.fill(0.0);
             (0.0, j)
         }
-        None => {
-            // 1.0 / n as the start vector: `n as f64` is exact for any size that fits in memory.
-            x.fill(1.0 / n as f64);
-            solve(x);
-            let estimate = one_norm(x);
-            if !estimate.is_finite() {
-                return (f64::INFINITY, 0);
-            }
-            if n == 1 {
-                return (estimate, 0);
-            }
-            for (x_i, s_i) in x.iter_mut().zip(signs.iter_mut()) {
-                *s_i = sign(*x_i);
-                *x_i = *s_i;
-            }
-            solve_transposed(x);
-            let Some(j) = index_of_max_abs(x) else {
-                return (f64::INFINITY, 0);
-            };
-            (estimate, j)
-        }
+        None => match cold_start(x, signs, &mut solve, &mut solve_transposed) {
+            ControlFlow::Continue(start) => start,
+            ControlFlow::Break(result) => return result,
+        },
     };
     let mut best = j;
     let mut iteration = 2;
@@ -58,17 +43,10 @@ pub(crate) fn inverse_one_norm_estimate(
             (estimate, best) = (latest, j);
         }
         // A repeated sign vector means convergence; no growth means cycling.
-        let repeated = x
-            .iter()
-            .zip(signs.iter())
-            .all(|(&x_i, &s_i)| sign(x_i) == s_i);
-        if repeated || !improved || n == 1 {
+        if same_signs(x, signs) || !improved || n == 1 {
             break;
         }
-        for (x_i, s_i) in x.iter_mut().zip(signs.iter_mut()) {
-            *s_i = sign(*x_i);
-            *x_i = *s_i;
-        }
+        take_signs(x, signs);
         solve_transposed(x);
         let last = j;
         let Some(next) = index_of_max_abs(x) else {
@@ -84,8 +62,46 @@ pub(crate) fn inverse_one_norm_estimate(
     if hint.is_some() {
         return (estimate, best);
     }
-    // Alternating-sign vector x_i = ±(1 + i/(n−1)), ‖x‖₁ = 3n/2: catches matrices where the
-    // iteration stalls on a poor local maximum.
+    let alternative = alternating_sign_bound(x, solve);
+    if !alternative.is_finite() {
+        return (f64::INFINITY, best);
+    }
+    (estimate.max(alternative), best)
+}
+
+/// The estimator's first power step from the uniform vector (no hint): the first bound and the
+/// column to try next (`Continue`), or the final answer (`Break`: a 1 × 1 matrix, or a solve
+/// that produced a non-finite value).
+fn cold_start(
+    x: &mut [f64],
+    signs: &mut [f64],
+    mut solve: impl FnMut(&mut [f64]),
+    mut solve_transposed: impl FnMut(&mut [f64]),
+) -> ControlFlow<(f64, usize), (f64, usize)> {
+    let n = x.len();
+    // 1.0 / n as the start vector: `n as f64` is exact for any size that fits in memory.
+    x.fill(1.0 / n as f64);
+    solve(x);
+    let estimate = one_norm(x);
+    if !estimate.is_finite() {
+        return ControlFlow::Break((f64::INFINITY, 0));
+    }
+    if n == 1 {
+        return ControlFlow::Break((estimate, 0));
+    }
+    take_signs(x, signs);
+    solve_transposed(x);
+    let Some(j) = index_of_max_abs(x) else {
+        return ControlFlow::Break((f64::INFINITY, 0));
+    };
+    ControlFlow::Continue((estimate, j))
+}
+
+/// The lower bound from the alternating-sign vector x_i = ±(1 + i/(n−1)), ‖x‖₁ = 3n/2 (n ≥ 2):
+/// it catches matrices where the iteration stalls on a poor local maximum. Non-finite if the
+/// solve overflows.
+fn alternating_sign_bound(x: &mut [f64], mut solve: impl FnMut(&mut [f64])) -> f64 {
+    let n = x.len();
     let last = (n - 1) as f64;
     let mut alternating = 1.0;
     for (i, x_i) in x.iter_mut().enumerate() {
@@ -93,11 +109,22 @@ pub(crate) fn inverse_one_norm_estimate(
         alternating = -alternating;
     }
     solve(x);
-    let alternative = 2.0 * one_norm(x) / (3.0 * n as f64);
-    if !alternative.is_finite() {
-        return (f64::INFINITY, best);
+    2.0 * one_norm(x) / (3.0 * n as f64)
+}
+
+/// ξ = sign(x), into `signs` and into `x` (the next right-hand side).
+fn take_signs(x: &mut [f64], signs: &mut [f64]) {
+    for (x_i, s_i) in x.iter_mut().zip(signs.iter_mut()) {
+        *s_i = sign(*x_i);
+        *x_i = *s_i;
     }
-    (estimate.max(alternative), best)
+}
+
+/// Whether sign(x) is the sign vector `signs` already holds.
+fn same_signs(x: &[f64], signs: &[f64]) -> bool {
+    x.iter()
+        .zip(signs.iter())
+        .all(|(&x_i, &s_i)| sign(x_i) == s_i)
 }
 
 /// `sign(x)` as in `dlacn2`: −1 for negative values beyond the underflow threshold, else +1.

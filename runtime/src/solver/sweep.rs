@@ -68,6 +68,7 @@ where
         extras: Option<Extras<'_, M>>,
         reached: &mut usize,
     ) -> Result<Convergence, SolveError> {
+        // Kept whole: one pass over the stages; its arms share the solver and the running totals.
         self.update_scale();
         self.diagnosed = (0, 0);
         let Self {
