@@ -78,8 +78,6 @@ mod mechanism;
 mod names;
 mod options;
 mod origin;
-#[cfg(test)]
-mod pendulum;
 mod physics;
 mod position;
 mod reactions;
