@@ -1,6 +1,6 @@
 //! The solver: unit scaling and the solve itself (its options are in `options`), which works through the scene's
 //! stages in order. Each explicit stage is assigned in closed form; each block is solved by
-//! Newton's method (`position.rs`) and, right after, its velocities and accelerations are
+//! Newton's method (`position`) and, right after, its velocities and accelerations are
 //! solved with the same factors: a block's derivatives depend only on earlier stages, so one
 //! block's factors are all the storage a solve needs.
 //!
