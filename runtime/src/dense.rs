@@ -396,3 +396,21 @@ where
         (self.indices[1].as_slice(), self.undetermined.as_slice())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Const;
+
+    #[test]
+    fn dense_buffers_hold_one_block_of_every_coordinate() {
+        let mut buffers = DenseBuffers::new(Const::<3>);
+        // Every block-sized part is n long, matrices n², one stage, no trig cache, and the
+        // force storage holds the n multipliers (no static factors to archive).
+        let expected = [
+            3, 3, 3, 3, 3, 3, 3, 3, 9, 9, 3, 3, 3, 9, 3, 3, 1, 3, 1, 0, 3, 1,
+        ];
+        assert_eq!(buffers.parts().lengths(), expected);
+        assert_eq!(buffers.parts().hints, &[usize::MAX]);
+    }
+}

@@ -14,6 +14,11 @@
 //! ([`Names`]).
 //! [`State::write_csv_row`] writes results without a heap.
 //!
+//! The root holds what a user writes. What only generated code (and the interpreter,
+//! `mechgen-interp`) names, the plan's stages, the solver's scratch storage, the rules generated
+//! checks call and the math shim, is in the `codegen` module, hidden from these docs: it is the
+//! contract with `mechgen`'s emitter, not an API.
+//!
 //! # Quick start
 //!
 //! ```
@@ -59,6 +64,8 @@ mod acceptance;
 mod assembly;
 mod block;
 mod block_signs;
+#[doc(hidden)]
+pub mod codegen;
 mod crossing;
 mod dense;
 mod error;
@@ -67,13 +74,10 @@ mod forces;
 mod geometry;
 mod lu;
 mod markers;
-pub mod math;
 mod mechanism;
 mod names;
 mod options;
 mod origin;
-#[cfg(test)]
-mod pendulum;
 mod physics;
 mod position;
 mod reactions;
@@ -84,9 +88,9 @@ mod structure;
 mod workspace;
 
 pub use assembly::{AssemblyError, GUESS_TIME, MAX_CONTINUATION_STEPS};
-pub use dense::{Dense, DenseBuffers};
-pub use error::{Described, Quantity, SolveError, first_load_fault};
-pub use geometry::{GeometryFault, MAX_LENGTH, Requirement, check_geometry};
+pub use dense::Dense;
+pub use error::{Described, Quantity, SolveError};
+pub use geometry::{GeometryFault, MAX_LENGTH, Requirement};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use markers::{
     AnglePosition, AngleState, AngleVelocity, PointPosition, PointState, PointVelocity,
@@ -97,7 +101,7 @@ pub use mechanism::{
 };
 pub use names::Names;
 pub use options::SolverOptions;
-pub use physics::{PhysicsFault, Subject, check_physics};
+pub use physics::{PhysicsFault, Subject};
 pub use reactions::{
     DistanceReaction, GearReaction, GroundLoad, PrismaticReaction, RackReaction, RevoluteReaction,
     SlotReaction, WeldReaction,
@@ -105,10 +109,7 @@ pub use reactions::{
 pub use simulate::{DEFAULT_MAX_HALVINGS, Simulation, sample_time};
 pub use solver::{Convergence, Solver};
 pub use state::{BodyState, Pose, PoseVelocity, State, write_csv_header};
-pub use structure::{Block, Pattern, Stage, Structured};
-#[cfg(feature = "alloc")]
-pub use workspace::VecBuffers;
-pub use workspace::{Buffers, Parts, Workspace};
+pub use structure::Structured;
 
 /// Re-exported so generated code and users name one crate.
 pub use nalgebra;

@@ -2,7 +2,7 @@
 //! the same rules `mechgen` applies to constants at compile time (a mass, an inertia, a
 //! stiffness, a free length or a damping cannot be negative), applied before every solve with
 //! the current parameter values, so that `--set m=-1` is refused instead of solving for a body
-//! of −1 kg. The geometry's counterpart is [`crate::check_geometry`]; the rules are
+//! of −1 kg. The geometry's counterpart is [`crate::codegen::check_geometry`]; the rules are
 //! [`Requirement`]s.
 
 use crate::geometry::Requirement;

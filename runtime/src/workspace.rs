@@ -8,7 +8,7 @@
 //! coordinates, largest block 6) needs 90 kB, where one dense Jacobian would need 289 MB.
 
 /// Storage the solver borrows for one solve. Implemented by [`Buffers`] (inline arrays, for
-/// generated scenes), [`crate::DenseBuffers`] (the dense reference) and, with the `alloc`
+/// generated scenes), [`crate::codegen::DenseBuffers`] (the dense reference) and, with the `alloc`
 /// feature, `VecBuffers` (the interpreter); the solver is its only user.
 pub trait Workspace {
     /// Every buffer at once, as disjoint slices.
@@ -278,5 +278,173 @@ impl Workspace for VecBuffers {
 
     fn diagnosis(&self) -> (&[usize], &[usize]) {
         (&self.indices[1], &self.undetermined)
+    }
+}
+
+#[cfg(test)]
+impl Parts<'_> {
+    /// The length of every part, in declaration order (the Newton vectors, the scales, the
+    /// factor storage, the estimator, then the rest).
+    pub(crate) fn lengths(&self) -> [usize; 22] {
+        let (n, s, f, e) = (&self.newton, &self.scales, &self.factors, &self.estimator);
+        [
+            n.phi.len(),
+            n.step.len(),
+            n.base.len(),
+            n.trial.len(),
+            n.gradient.len(),
+            s.rows.len(),
+            s.cols.len(),
+            s.inverse_cols.len(),
+            f.values.len(),
+            f.lu.len(),
+            f.swaps.len(),
+            e.x.len(),
+            e.signs.len(),
+            self.dense.len(),
+            self.row_order.len(),
+            self.col_order.len(),
+            self.hints.len(),
+            self.undetermined.len(),
+            self.downstream.len(),
+            self.trig.len(),
+            self.forces.len(),
+            self.archived.len(),
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Block size 3, 7 factor values, 4 stages, 9 coordinates, 5 trig slots, 11 force values.
+    type Small = Buffers<3, 7, 4, 9, 5, 11>;
+
+    /// [`Parts::lengths`] for `Small`: B-long vectors, S values, B² matrices, K per-stage
+    /// words, N undetermined coordinates, T trig slots, R force values.
+    const SMALL: [usize; 22] = [
+        3, 3, 3, 3, 3, 3, 3, 3, 7, 9, 3, 3, 3, 9, 3, 3, 4, 9, 4, 5, 11, 4,
+    ];
+
+    #[test]
+    fn buffers_lend_every_part_at_its_declared_size() {
+        let mut buffers = Small::new();
+        assert_eq!(buffers.parts().lengths(), SMALL);
+        // No warm-start column yet: the estimator starts cold in every stage.
+        assert!(buffers.parts().hints.iter().all(|&h| h == usize::MAX));
+        // Without forces the force storage is empty.
+        let mut kinematic = Buffers::<3, 7, 4, 9, 5>::new();
+        assert_eq!(kinematic.parts().forces.len(), 0);
+    }
+
+    #[cfg(feature = "alloc")]
+    #[test]
+    fn vec_buffers_have_the_inline_buffers_sizes() {
+        let mut buffers = VecBuffers::new(3, 7, 4, 9, 5, 11);
+        assert_eq!(buffers.parts().lengths(), SMALL);
+        assert!(buffers.parts().hints.iter().all(|&h| h == usize::MAX));
+    }
+
+    /// Writes a different value into every element of every part, reads them all back from a
+    /// second borrow, and returns the diagnosis lists.
+    fn round_trip<W: Workspace>(workspace: &mut W) -> (std::vec::Vec<usize>, std::vec::Vec<usize>) {
+        let mut parts = workspace.parts();
+        let mut next = 0.0;
+        for part in floats(&mut parts) {
+            for x in part.iter_mut() {
+                next += 1.0;
+                *x = next;
+            }
+        }
+        let mut next = 0;
+        for part in [
+            &mut *parts.factors.swaps,
+            &mut *parts.row_order,
+            &mut *parts.col_order,
+            &mut *parts.hints,
+            &mut *parts.undetermined,
+        ] {
+            for x in part.iter_mut() {
+                next += 1;
+                *x = next;
+            }
+        }
+        parts.downstream.fill(true);
+        parts.archived.fill(true);
+        // A fresh borrow sees every value where it was written: no part shares storage with
+        // another, and nothing is lost between solves (the warm-start hints must persist).
+        let mut parts = workspace.parts();
+        let mut expected = 0.0;
+        for part in floats(&mut parts) {
+            for &x in part.iter() {
+                expected += 1.0;
+                assert_eq!(x, expected);
+            }
+        }
+        let mut expected = 0;
+        for part in [
+            &*parts.factors.swaps,
+            &*parts.row_order,
+            &*parts.col_order,
+            &*parts.hints,
+            &*parts.undetermined,
+        ] {
+            for &x in part {
+                expected += 1;
+                assert_eq!(x, expected);
+            }
+        }
+        assert!(
+            parts
+                .downstream
+                .iter()
+                .chain(parts.archived.iter())
+                .all(|&b| b)
+        );
+        let (rows, columns) = workspace.diagnosis();
+        (rows.to_vec(), columns.to_vec())
+    }
+
+    /// Every `f64` part.
+    fn floats<'p>(parts: &'p mut Parts<'_>) -> [&'p mut [f64]; 15] {
+        let (n, s, f, e) = (
+            &mut parts.newton,
+            &mut parts.scales,
+            &mut parts.factors,
+            &mut parts.estimator,
+        );
+        [
+            &mut *n.phi,
+            &mut *n.step,
+            &mut *n.base,
+            &mut *n.trial,
+            &mut *n.gradient,
+            &mut *s.rows,
+            &mut *s.cols,
+            &mut *s.inverse_cols,
+            &mut *f.values,
+            &mut *f.lu,
+            &mut *e.x,
+            &mut *e.signs,
+            &mut *parts.dense,
+            &mut *parts.trig,
+            &mut *parts.forces,
+        ]
+    }
+
+    #[test]
+    fn parts_are_disjoint_persist_and_the_diagnosis_reads_the_solvers_lists() {
+        let (rows, columns) = round_trip(&mut Small::new());
+        // The row order (after swaps: 4, 5, 6) and the undetermined coordinates (after swaps,
+        // row and column orders and hints: 14, …, 22).
+        assert_eq!(rows, [4, 5, 6]);
+        assert_eq!(columns, (14..=22).collect::<std::vec::Vec<_>>());
+        #[cfg(feature = "alloc")]
+        {
+            let (rows, columns) = round_trip(&mut VecBuffers::new(3, 7, 4, 9, 5, 11));
+            assert_eq!(rows, [4, 5, 6]);
+            assert_eq!(columns, (14..=22).collect::<std::vec::Vec<_>>());
+        }
     }
 }

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{Q, Reference, SliderCrank, reference};
+use common::slider_crank::{Q, Reference, SliderCrank, reference};
 use mechgen_runtime::{Mechanism, Simulation, SolveError, Solver, State, write_csv_header};
 
 fn assert_close(computed: &Q, expected: &Q, what: &str, t: f64) {

@@ -14,9 +14,10 @@
 //! (the numbers below include 1e12 to 1e20), where rounding alone breaks their constraints.
 
 use mechgen_interp::Interpreted;
+use mechgen_runtime::codegen::Stage;
 use mechgen_runtime::{
-    DEFAULT_MAX_HALVINGS, Mechanism, Outputs, Simulation, Solver, SolverOptions, Stage, Structured,
-    Unit, Vector, nalgebra::Dyn,
+    DEFAULT_MAX_HALVINGS, Mechanism, Outputs, Simulation, Solver, SolverOptions, Structured, Unit,
+    Vector, nalgebra::Dyn,
 };
 
 /// The scenes mutants are made from: the examples, and a slider-crank with every load kind

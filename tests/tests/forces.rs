@@ -272,7 +272,7 @@ fn generated_force_solve_matches_the_interpreter_across_blocks() {
             .filter(|&s| {
                 matches!(
                     Carriage::default().stage(s),
-                    Some(mechgen_runtime::Stage::Block(_))
+                    Some(mechgen_runtime::codegen::Stage::Block(_))
                 )
             })
             .count()

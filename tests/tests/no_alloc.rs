@@ -1,7 +1,8 @@
 //! Generated code through the runtime allocates nothing: positions, velocities and
 //! accelerations of the seed over many steps, the force solve (reactions and driver efforts),
 //! sub-stepping, assembly at a later start time (the motion followed from t = 0), every error
-//! path with its description, and CSV output.
+//! path with its description, and CSV output; and the dense reference (`Dense`, any mechanism
+//! as one block) on the same paths.
 //!
 //! A counting global allocator wraps the system one. This file holds a single test so that no
 //! other test thread allocates while it counts.
@@ -18,7 +19,7 @@ use mechgen_examples::scenes::{
 use mechgen_examples::stability::{
     self, FlexiblePistonCrank, Parallelogram, SliderCrank, Unclosable,
 };
-use mechgen_runtime::{Mechanism, Simulation, SolveError, Solver};
+use mechgen_runtime::{Dense, Mechanism, Simulation, SolveError, Solver, write_csv_header};
 
 static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
 
@@ -160,6 +161,36 @@ fn generated_scenes_solve_without_allocating() {
     let mut nan = Solver::new(FlexiblePistonCrank::default());
     nan.mechanism_mut().omega = f64::NAN;
     assert!(nan.solve_position(&mut Default::default(), 0.0).is_err());
+
+    // The dense reference: one solve with the CSV header and row, a run with and without the
+    // predictor, a NaN time and a pose the rod is too short to reach, described.
+    let mut solver = Solver::new(Dense::new(SliderCrank::default()));
+    let mut guess = Default::default();
+    solver.mechanism().initial_guess(&mut guess);
+    let state = solver.solve(0.25, &guess).expect("assembles");
+    write_csv_header(solver.mechanism(), &mut sink).unwrap();
+    state.write_csv_row(&mut sink).unwrap();
+    let mut simulation = Simulation::new(solver, 0.0).expect("assembles");
+    let mut steps = 0;
+    simulation
+        .run(3.0, 500, |state| {
+            steps += 1;
+            state.write_csv_row(&mut sink).unwrap();
+        })
+        .expect("the dense reference solves");
+    simulation.set_predictor(false);
+    simulation.step_to(3.1).expect("solves");
+    let nan = simulation.step_to(f64::NAN).unwrap_err();
+    write!(sink, "{nan}").unwrap();
+    simulation.solver_mut().mechanism_mut().inner_mut().l = 0.5;
+    let unreachable = simulation.step_to(3.9).unwrap_err();
+    write!(
+        sink,
+        "{}",
+        unreachable.describe(simulation.solver().mechanism())
+    )
+    .unwrap();
+    assert_eq!(steps, 501);
     let allocations = ALLOCATIONS.load(Ordering::SeqCst) - before;
 
     assert_eq!(allocations, 0, "heap allocations in solve paths");

@@ -10,8 +10,9 @@
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
+use mechgen_runtime::codegen::{Block, Stage};
 use mechgen_runtime::nalgebra::{DefaultAllocator, U1};
-use mechgen_runtime::{Accelerations, Block, Lu, Matrix, Stage, Storage, Structured, Vector};
+use mechgen_runtime::{Accelerations, Lu, Matrix, Storage, Structured, Vector};
 
 use super::sweep::Work;
 

@@ -4,8 +4,9 @@
 
 use mechgen::expr::tape::{Inputs, Tape};
 use mechgen::plan::kernels::{self, Buffer, Method};
+use mechgen_runtime::codegen::{Block, Pattern, Stage, VecBuffers};
 use mechgen_runtime::nalgebra::Dyn;
-use mechgen_runtime::{Block, Pattern, Stage, Structured, VecBuffers, Vector};
+use mechgen_runtime::{Structured, Vector};
 
 use super::{Interpreted, Scratch};
 

@@ -4,11 +4,11 @@
 use mechgen::Scene;
 use mechgen::expr::tape::Tape;
 use mechgen::model::{geometry, physics};
-use mechgen_runtime::first_load_fault;
+use mechgen_runtime::codegen::{check_physics, first_load_fault};
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{
     Accelerations, Forces, GeometryFault, Matrix, Mechanism, Names, Outputs, ParameterError,
-    PhysicsFault, Quantity, Requirement, Subject, Unit, Vector, Velocities, check_physics,
+    PhysicsFault, Quantity, Requirement, Subject, Unit, Vector, Velocities,
 };
 
 use super::Interpreted;
@@ -196,7 +196,7 @@ impl Mechanism for Interpreted {
     fn check_geometry(&self) -> Result<(), GeometryFault> {
         let tape = &self.textbook.geometry_values;
         self.check_values(&self.geometry, tape, |value, c| {
-            mechgen_runtime::check_geometry(
+            mechgen_runtime::codegen::check_geometry(
                 value,
                 requirement(c.requirement),
                 c.subject,

@@ -577,7 +577,7 @@ impl<'w, 'a> Writer<'w, 'a> {
             TokenStream::new()
         } else {
             let funcs = self.funcs.iter().map(|f| format_ident!("{}", f));
-            quote! { use ::mechgen_runtime::math::{#(#funcs),*}; }
+            quote! { use ::mechgen_runtime::codegen::math::{#(#funcs),*}; }
         };
         self.loads.sort_by_key(|(v, _)| *v);
         self.trig_loads.sort_by_key(|(i, _)| *i);

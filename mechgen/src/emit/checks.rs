@@ -81,7 +81,7 @@ impl Context<'_> {
             let subject = c.subject.tokens();
             let parameter = idx(c.parameter);
             quote! {
-                ::mechgen_runtime::#check(
+                ::mechgen_runtime::codegen::#check(
                     #name,
                     ::mechgen_runtime::Requirement::#requirement,
                     #subject,

@@ -101,7 +101,7 @@ impl Context<'_> {
             ) -> ::core::option::Option<::mechgen_runtime::Quantity> {
                 let mut out = [0.0_f64; #k];
                 #body
-                ::mechgen_runtime::first_load_fault(&out)
+                ::mechgen_runtime::codegen::first_load_fault(&out)
             }
         }
     }

@@ -3,7 +3,7 @@
 //! (`impl Structured`, in `plan`) and the named body accessors.
 //!
 //! Bodies are straight-line code (`body`): no loops, no allocation, no `std`, no `unsafe`;
-//! elementary functions come from `::mechgen_runtime::math`. Zero entries are never computed:
+//! elementary functions come from `::mechgen_runtime::codegen::math`. Zero entries are never computed:
 //! an output with zeros is cleared once and only non-zeros are written.
 
 mod body;
@@ -794,8 +794,8 @@ impl Context<'_> {
                 quote! {
                     #[doc = #doc]
                     #[allow(dead_code)]
-                    const #name: ::mechgen_runtime::math::Spline<'static> =
-                        ::mechgen_runtime::math::Spline {
+                    const #name: ::mechgen_runtime::codegen::math::Spline<'static> =
+                        ::mechgen_runtime::codegen::math::Spline {
                             knots: &[#(#knots),*],
                             segments: &[#(#segments),*],
                         };

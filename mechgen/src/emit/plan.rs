@@ -88,17 +88,17 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan, kernels: &Kernels) 
         }
 
         impl ::mechgen_runtime::Structured for #name {
-            type Workspace = ::mechgen_runtime::Buffers<#b, #s, #k, #n, #trig_len #forces>;
+            type Workspace = ::mechgen_runtime::codegen::Buffers<#b, #s, #k, #n, #trig_len #forces>;
 
             fn workspace(&self) -> Self::Workspace {
-                ::mechgen_runtime::Buffers::new()
+                ::mechgen_runtime::codegen::Buffers::new()
             }
 
             fn stage_count(&self) -> usize {
                 #stage_count
             }
 
-            fn stage(&self, index: usize) -> ::core::option::Option<::mechgen_runtime::Stage<'_>> {
+            fn stage(&self, index: usize) -> ::core::option::Option<::mechgen_runtime::codegen::Stage<'_>> {
                 Self::STAGES.get(index).copied()
             }
 

@@ -27,7 +27,7 @@ pub(super) fn stage_table(model: &Model, plan: &Plan, shapes: &[StageShape]) -> 
     let count = idx(entries.len());
     quote! {
         #(#[doc = #docs])*
-        pub const STAGES: [::mechgen_runtime::Stage<'static>; #count] = [#(#entries),*];
+        pub const STAGES: [::mechgen_runtime::codegen::Stage<'static>; #count] = [#(#entries),*];
     }
 }
 
@@ -44,7 +44,7 @@ fn stage_entry(shape: &StageShape) -> TokenStream {
     );
     let Some(block) = &shape.block else {
         return quote! {
-            ::mechgen_runtime::Stage::Explicit { equations: #e, coordinates: #c, reads: #r }
+            ::mechgen_runtime::codegen::Stage::Explicit { equations: #e, coordinates: #c, reads: #r }
         };
     };
     let pattern = block.pattern.iter().map(|&(row, col)| {
@@ -53,10 +53,10 @@ fn stage_entry(shape: &StageShape) -> TokenStream {
     });
     let (slots, pivots) = (idx(block.slots), list(&block.pivots));
     quote! {
-        ::mechgen_runtime::Stage::Block(::mechgen_runtime::Block {
+        ::mechgen_runtime::codegen::Stage::Block(::mechgen_runtime::codegen::Block {
             equations: #e,
             coordinates: #c,
-            pattern: ::mechgen_runtime::Pattern::Sparse(&[#(#pattern),*]),
+            pattern: ::mechgen_runtime::codegen::Pattern::Sparse(&[#(#pattern),*]),
             slots: #slots,
             pivots: #pivots,
             reads: #r,

@@ -85,7 +85,7 @@ impl Func {
         Func::Acos,
     ];
 
-    /// The name used in specs and in generated code (`::mechgen_runtime::math::NAME`).
+    /// The name used in specs and in generated code (`::mechgen_runtime::codegen::math::NAME`).
     pub fn name(self) -> &'static str {
         match self {
             Func::Sin => "sin",
@@ -129,7 +129,7 @@ pub enum Func2 {
 }
 
 impl Func2 {
-    /// The name in generated code (`::mechgen_runtime::math::NAME`).
+    /// The name in generated code (`::mechgen_runtime::codegen::math::NAME`).
     pub fn name(self) -> &'static str {
         match self {
             Func2::Atan2 => "atan2",
@@ -148,7 +148,7 @@ impl Func2 {
 
 /// `if a <= b { x } else { y }`, and NaN (`a + b`) when `a` or `b` is NaN: the one branching
 /// node (min, max, abs and the clamped motion laws lower to it), shared by folding and the
-/// interpreter; generated code calls `::mechgen_runtime::math::select`, the same rule.
+/// interpreter; generated code calls `::mechgen_runtime::codegen::math::select`, the same rule.
 pub fn select(a: f64, b: f64, x: f64, y: f64) -> f64 {
     if a <= b {
         x

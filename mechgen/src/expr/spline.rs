@@ -9,7 +9,7 @@
 //! A table holds the knots and, per segment, the cubic's coefficients in the distance from the
 //! segment's base: segment 0 extrapolates left of the first knot (based at it), segment k
 //! spans knots k − 1 … k, the last extrapolates right of the last knot. The runtime evaluates
-//! the same layout (`mechgen_runtime::math::Spline`); generated code emits the table as a
+//! the same layout (`mechgen_runtime::codegen::math::Spline`); generated code emits the table as a
 //! constant.
 
 /// A natural cubic spline as a table; see the module documentation.

@@ -111,7 +111,7 @@ pub fn derive(model: &mut Model) -> Vec<Id> {
 }
 
 /// Two values per load, for naming the load that makes F non-finite (on the failure path of
-/// the force solve, `mechgen_runtime::first_load_fault`): the sum of its contributions to F,
+/// the force solve, `mechgen_runtime::codegen::first_load_fault`): the sum of its contributions to F,
 /// finite exactly when they all are, and for a spring the squared distance between its ends
 /// (its direction is undefined where they meet), 1 for other loads.
 pub fn load_witnesses(model: &mut Model) -> Vec<Id> {

@@ -1,15 +1,15 @@
-//! A hand-written driven pendulum, the smallest mechanism the unit tests solve.
+//! A hand-written driven pendulum, the smallest mechanism the tests solve.
 //!
 //! One body, pinned at the origin at distance `a` from its reference point, its angle driven as
 //! `θ = ω t`: `x = a cos θ`, `y = a sin θ`. `duplicate_pin` replaces the driver with a copy of the
 //! first pin equation to make Φ_q singular on purpose. With `mass` set it computes forces: a
 //! mass `m` with inertia `J` at its reference point, under gravity `(0, −g)`.
 
-use nalgebra::Const;
-
-use crate::math::{cos, sin};
-use crate::mechanism::{
-    Accelerations, Forces, Matrix, Mechanism, Outputs, ParameterError, Unit, Vector, Velocities,
+use mechgen_runtime::codegen::math::{cos, sin};
+use mechgen_runtime::nalgebra::Const;
+use mechgen_runtime::{
+    Accelerations, Forces, Matrix, Mechanism, Names, Outputs, ParameterError, Unit, Vector,
+    Velocities,
 };
 
 #[derive(Debug, Clone)]
@@ -49,18 +49,18 @@ const COORDINATES: [&str; 3] = ["rod.x", "rod.y", "rod.theta"];
 const EQUATIONS: [&str; 3] = ["pin.x", "pin.y", "drive"];
 
 /// The pendulum's names, as a generated scene's `NAMES`.
-pub const NAMES: crate::Names = crate::Names {
+pub const NAMES: Names = Names {
     mechanism: "Pendulum",
     coordinates: &COORDINATES,
     equations: &EQUATIONS,
-    ..crate::Names::NONE
+    ..Names::NONE
 };
 
 impl Mechanism for Pendulum {
     type Dim = Const<3>;
     type Markers = [f64; 0];
 
-    fn names(&self) -> &'static crate::Names {
+    fn names(&self) -> &'static Names {
         &NAMES
     }
     fn dim(&self) -> Const<3> {
@@ -212,8 +212,8 @@ mod dynamic {
     use super::{
         Accelerations, DynPendulum, Mechanism, Outputs, ParameterError, Unit, Vector, Velocities,
     };
-    use crate::mechanism::Matrix;
-    use nalgebra::{Const, Dyn, Matrix3, Vector3};
+    use mechgen_runtime::Matrix;
+    use mechgen_runtime::nalgebra::{Const, Dyn, Matrix3, Vector3};
 
     fn fixed(v: &Vector<Dyn>) -> Vector3<f64> {
         Vector3::from_iterator(v.iter().copied())

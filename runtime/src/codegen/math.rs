@@ -1,6 +1,6 @@
 //! The elementary functions generated code calls: `libm`, so that it needs no `std`.
 //!
-//! Generated code uses these through absolute paths (`::mechgen_runtime::math::sin`), never
+//! Generated code uses these through absolute paths (`::mechgen_runtime::codegen::math::sin`), never
 //! `f64::sin`, which is unavailable in `no_std` builds.
 
 /// Sine.
