@@ -123,6 +123,7 @@ fn scene(mut model: Model) -> Scene {
     });
     let kernels = kernels::list(
         &model.arena,
+        model.dim(),
         &plan,
         forces.as_ref(),
         &kinematics.markers,

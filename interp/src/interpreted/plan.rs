@@ -2,6 +2,7 @@
 //! behind the runtime's `Structured` trait. Where generated code has a `match` on the stage,
 //! a method here looks the stage's kernel up in a table.
 
+use mechgen::expr::Var;
 use mechgen::expr::tape::{Inputs, Tape};
 use mechgen::plan::kernels::{self, Buffer, Method};
 use mechgen_runtime::codegen::{Block, Pattern, Stage, VecBuffers};
@@ -15,6 +16,9 @@ use super::{Interpreted, Scratch};
 struct Compiled {
     tape: Tape,
     outputs: Vec<(Buffer, usize)>,
+    /// Whether it reads the trig cache and the multipliers.
+    reads_trig: bool,
+    reads_lambda: bool,
 }
 
 impl Compiled {
@@ -22,6 +26,11 @@ impl Compiled {
         Compiled {
             tape: Tape::with_inputs(arena, &kernel.roots, &kernel.cached),
             outputs: kernel.outputs.clone(),
+            reads_trig: !kernel.cached.is_empty(),
+            reads_lambda: kernel
+                .roots
+                .iter()
+                .any(|&root| (arena.variables(root).iter()).any(|v| matches!(v, Var::Lambda(_)))),
         }
     }
 }
@@ -30,8 +39,14 @@ impl Compiled {
 /// the kernel of a stage and method in a table, where generated code has a `match`.
 #[derive(Debug, Clone)]
 pub(super) struct PlanTapes {
-    /// The kernel list: the stage table, the static LUs, the workspace's sizes.
+    /// The kernel list's stage table, static LUs and workspace sizes (its kernels are below,
+    /// compiled).
     list: kernels::Kernels,
+    /// Per method (`[method as usize]`): whether any stage has a kernel of it, and whether
+    /// any of those reads the trig cache and the multipliers (generated code then views the
+    /// runtime's slices as arrays before it dispatches on the stage).
+    present: [bool; Method::ALL.len()],
+    views: [(bool, bool); Method::ALL.len()],
     /// `dispatch[stage][method as usize]`: the stage's kernel of that method in `kernels`.
     dispatch: Vec<[Option<usize>; Method::ALL.len()]>,
     kernels: Vec<Compiled>,
@@ -47,12 +62,27 @@ impl PlanTapes {
             dispatch[kernel.stage][kernel.method as usize] = Some(k);
         }
         let compile = |kernel: &kernels::Kernel| Compiled::new(arena, kernel);
+        let kernels: Vec<Compiled> = list.stages.iter().map(|k| compile(&k.kernel)).collect();
+        let of = |m: Method| {
+            let stages = list.stages.iter().zip(&kernels);
+            stages.filter(move |(k, _)| k.method == m).map(|(_, c)| c)
+        };
         PlanTapes {
             dispatch,
-            kernels: list.stages.iter().map(|k| compile(&k.kernel)).collect(),
+            present: Method::ALL.map(|m| of(m).next().is_some()),
+            views: Method::ALL.map(|m| {
+                let lambda = m == Method::Multipliers || of(m).any(|c| c.reads_lambda);
+                (of(m).any(|c| c.reads_trig), lambda)
+            }),
+            kernels,
             markers: list.markers.as_ref().map(compile),
             branches: list.branches.iter().map(compile).collect(),
-            list: list.clone(),
+            list: kernels::Kernels {
+                stages: Vec::new(),
+                markers: None,
+                branches: Vec::new(),
+                ..list.clone()
+            },
         }
     }
 
@@ -62,6 +92,36 @@ impl PlanTapes {
         self.kernels.get(k)
     }
 
+    /// What a call of `method` for `stage` finds, given the lengths of the slices it was
+    /// passed: the trig cache's and the multipliers' (`views`, which the method views whole
+    /// whatever the stage), and each output's (which the stage's kernel views).
+    fn find(
+        &self,
+        stage: usize,
+        method: Method,
+        views: [usize; 2],
+        outputs: &[(Buffer, usize)],
+    ) -> Found<'_> {
+        let m = method as usize;
+        if !self.present[m] {
+            return Found::Nowhere;
+        }
+        let (trig, lambda) = self.views[m];
+        let sizes = &self.list.sizes;
+        if (trig && views[0] < sizes.trig) || (lambda && views[1] < sizes.coordinates) {
+            return Found::Short;
+        }
+        let Some(kernel) = self.kernel(stage, method) else {
+            return Found::Elsewhere;
+        };
+        let fits = |&(buffer, len): &(Buffer, usize)| len >= self.list.buffer_len(stage, buffer);
+        if outputs.iter().all(fits) {
+            Found::Kernel(kernel)
+        } else {
+            Found::Short
+        }
+    }
+
     pub(super) fn tapes(&self) -> impl Iterator<Item = &Tape> {
         self.kernels
             .iter()
@@ -69,6 +129,21 @@ impl PlanTapes {
             .chain(&self.branches)
             .map(|k| &k.tape)
     }
+}
+
+/// What a `Structured` method finds for a stage, and so what it writes, as generated code
+/// does.
+enum Found<'a> {
+    /// The stage's kernel: its values.
+    Kernel(&'a Compiled),
+    /// No kernel here but other stages have one: generated code's `match` falls through,
+    /// writing nothing.
+    Elsewhere,
+    /// No stage has one: generated code has no such method and the trait's default runs.
+    Nowhere,
+    /// A buffer shorter than the kernel's arrays: generated code cannot view it as one and
+    /// writes NaN to its outputs rather than leave stale values.
+    Short,
 }
 
 impl Structured for Interpreted {
@@ -111,9 +186,15 @@ impl Structured for Interpreted {
     }
 
     fn assign_positions(&self, stage: usize, q: &mut Vector<Dyn>, trig: &[f64], t: f64) {
-        let inputs = self.inputs_with(q.as_slice(), &[], &[], trig, t);
-        if let Some(kernel) = self.evaluate(stage, Method::Positions, inputs) {
-            self.scatter(kernel, Buffer::Q, q.as_mut_slice());
+        let found = self.plan.find(
+            stage,
+            Method::Positions,
+            [trig.len(), 0],
+            &[(Buffer::Q, q.len())],
+        );
+        if let Some(kernel) = self.ready(found, q.as_mut_slice()) {
+            self.evaluate(kernel, self.inputs_with(q.as_slice(), &[], &[], trig, t));
+            self.scatter(kernel, Method::Positions.target(), q.as_mut_slice());
         }
     }
 
@@ -125,9 +206,16 @@ impl Structured for Interpreted {
         qd: &mut Vector<Dyn>,
         t: f64,
     ) {
-        let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), &[], trig, t);
-        if let Some(kernel) = self.evaluate(stage, Method::Velocities, inputs) {
-            self.scatter(kernel, Buffer::Qd, qd.as_mut_slice());
+        let outputs = [(Buffer::Qd, qd.len())];
+        let found = self
+            .plan
+            .find(stage, Method::Velocities, [trig.len(), 0], &outputs);
+        if let Some(kernel) = self.ready(found, qd.as_mut_slice()) {
+            self.evaluate(
+                kernel,
+                self.inputs_with(q.as_slice(), qd.as_slice(), &[], trig, t),
+            );
+            self.scatter(kernel, Method::Velocities.target(), qd.as_mut_slice());
         }
     }
 
@@ -140,9 +228,16 @@ impl Structured for Interpreted {
         qdd: &mut Vector<Dyn>,
         t: f64,
     ) {
-        let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t);
-        if let Some(kernel) = self.evaluate(stage, Method::Accelerations, inputs) {
-            self.scatter(kernel, Buffer::Qdd, qdd.as_mut_slice());
+        let outputs = [(Buffer::Qdd, qdd.len())];
+        let found = self
+            .plan
+            .find(stage, Method::Accelerations, [trig.len(), 0], &outputs);
+        if let Some(kernel) = self.ready(found, qdd.as_mut_slice()) {
+            self.evaluate(
+                kernel,
+                self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t),
+            );
+            self.scatter(kernel, Method::Accelerations.target(), qdd.as_mut_slice());
         }
     }
 
@@ -156,17 +251,32 @@ impl Structured for Interpreted {
         values: &mut [f64],
     ) {
         self.evaluations.set(self.evaluations.get() + 1);
-        let inputs = self.inputs_with(q.as_slice(), &[], &[], trig, t);
-        if let Some(kernel) = self.evaluate(stage, Method::Jacobian, inputs) {
-            self.scatter(kernel, Buffer::Phi, phi);
-            self.scatter(kernel, Buffer::Values, values);
+        let outputs = [(Buffer::Phi, phi.len()), (Buffer::Values, values.len())];
+        match self
+            .plan
+            .find(stage, Method::Jacobian, [trig.len(), 0], &outputs)
+        {
+            Found::Kernel(kernel) => {
+                self.evaluate(kernel, self.inputs_with(q.as_slice(), &[], &[], trig, t));
+                self.scatter(kernel, Buffer::Phi, phi);
+                self.scatter(kernel, Method::Jacobian.target(), values);
+            }
+            Found::Short => {
+                phi.fill(f64::NAN);
+                values.fill(f64::NAN);
+            }
+            Found::Elsewhere | Found::Nowhere => {}
         }
     }
 
     fn fill_trig(&self, stage: usize, q: &Vector<Dyn>, trig: &mut [f64]) {
-        let inputs = self.inputs(q.as_slice(), &[], 0.0);
-        if let Some(kernel) = self.evaluate(stage, Method::FillTrig, inputs) {
-            self.scatter(kernel, Buffer::Trig, trig);
+        let outputs = [(Buffer::Trig, trig.len())];
+        let found = self
+            .plan
+            .find(stage, Method::FillTrig, [trig.len(), 0], &outputs);
+        if let Some(kernel) = self.ready(found, trig) {
+            self.evaluate(kernel, self.inputs(q.as_slice(), &[], 0.0));
+            self.scatter(kernel, Method::FillTrig.target(), trig);
         }
     }
 
@@ -228,11 +338,14 @@ impl Structured for Interpreted {
         t: f64,
         out: &mut [f64],
     ) {
+        let found = self.plan.find(
+            stage,
+            Method::VelocityRhs,
+            [trig.len(), 0],
+            &[(Buffer::Out, out.len())],
+        );
         let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), &[], trig, t);
-        match self.evaluate(stage, Method::VelocityRhs, inputs) {
-            Some(kernel) => self.scatter(kernel, Buffer::Out, out),
-            None => out.fill(f64::NAN),
-        }
+        self.right_hand_side(found, inputs, out);
     }
 
     fn acceleration_rhs(
@@ -245,11 +358,12 @@ impl Structured for Interpreted {
         t: f64,
         out: &mut [f64],
     ) {
+        let outputs = [(Buffer::Out, out.len())];
+        let found = self
+            .plan
+            .find(stage, Method::AccelerationRhs, [trig.len(), 0], &outputs);
         let inputs = self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t);
-        match self.evaluate(stage, Method::AccelerationRhs, inputs) {
-            Some(kernel) => self.scatter(kernel, Buffer::Out, out),
-            None => out.fill(f64::NAN),
-        }
+        self.right_hand_side(found, inputs, out);
     }
 
     fn assign_multipliers(
@@ -262,16 +376,28 @@ impl Structured for Interpreted {
         lambda: &mut [f64],
         t: f64,
     ) {
-        let inputs = Inputs {
-            lambda,
-            ..self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t)
-        };
-        match self.evaluate(stage, Method::Multipliers, inputs) {
-            Some(kernel) => self.scatter(kernel, Buffer::Lambda, lambda),
-            // As the trait's default: the stage's multipliers are unknown.
-            None => {
-                let equations = self.plan.list.shapes.get(stage).map(|s| &s.equations);
-                for &e in equations.into_iter().flatten() {
+        let outputs = [(Buffer::Lambda, lambda.len())];
+        match self.plan.find(
+            stage,
+            Method::Multipliers,
+            [trig.len(), lambda.len()],
+            &outputs,
+        ) {
+            Found::Kernel(kernel) => {
+                let inputs = Inputs {
+                    lambda,
+                    ..self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t)
+                };
+                self.evaluate(kernel, inputs);
+                self.scatter(kernel, Method::Multipliers.target(), lambda);
+            }
+            Found::Short => lambda.fill(f64::NAN),
+            Found::Elsewhere => {}
+            // The trait's default: an explicit stage's multipliers are unknown.
+            Found::Nowhere => {
+                let shape = self.plan.list.shapes.get(stage);
+                let explicit = shape.filter(|s| s.block.is_none());
+                for &e in explicit.into_iter().flat_map(|s| &s.equations) {
                     if let Some(l) = lambda.get_mut(e) {
                         *l = f64::NAN;
                     }
@@ -291,27 +417,53 @@ impl Structured for Interpreted {
         t: f64,
         out: &mut [f64],
     ) {
+        let found = self.plan.find(
+            stage,
+            Method::ForceRhs,
+            [trig.len(), lambda.len()],
+            &[(Buffer::Out, out.len())],
+        );
         let inputs = Inputs {
             lambda,
             ..self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t)
         };
-        match self.evaluate(stage, Method::ForceRhs, inputs) {
-            Some(kernel) => self.scatter(kernel, Buffer::Out, out),
-            None => out.fill(f64::NAN),
-        }
+        self.right_hand_side(found, inputs, out);
     }
 }
 
 impl Interpreted {
-    /// Evaluates stage `stage`'s kernel of `method` into the scratch values, or returns `None`
-    /// when the stage has no such kernel. Every value is computed before
+    /// The kernel an assignment (of positions, rates or cache slots) runs; NaN in `out` where
+    /// the buffers do not fit; nothing without a kernel (the trait's default writes nothing).
+    fn ready<'a>(&self, found: Found<'a>, out: &mut [f64]) -> Option<&'a Compiled> {
+        match found {
+            Found::Kernel(kernel) => Some(kernel),
+            Found::Short => {
+                out.fill(f64::NAN);
+                None
+            }
+            Found::Elsewhere | Found::Nowhere => None,
+        }
+    }
+
+    /// A block's right-hand side: the kernel's values, or NaN where the buffers do not fit or
+    /// no stage has such a kernel (the trait's default).
+    fn right_hand_side(&self, found: Found<'_>, inputs: Inputs<'_>, out: &mut [f64]) {
+        match found {
+            Found::Kernel(kernel) => {
+                self.evaluate(kernel, inputs);
+                self.scatter(kernel, Buffer::Out, out);
+            }
+            Found::Short | Found::Nowhere => out.fill(f64::NAN),
+            Found::Elsewhere => {}
+        }
+    }
+
+    /// Evaluates `kernel` into the scratch values. Every value is computed before
     /// [`Interpreted::scatter`] writes any back, as generated code loads its inputs first.
-    fn evaluate(&self, stage: usize, method: Method, inputs: Inputs<'_>) -> Option<&Compiled> {
-        let kernel = self.plan.kernel(stage, method)?;
+    fn evaluate(&self, kernel: &Compiled, inputs: Inputs<'_>) {
         let mut scratch = self.scratch.borrow_mut();
         let Scratch { slots, values } = &mut *scratch;
         kernel.tape.eval(inputs, slots, values);
-        Some(kernel)
     }
 
     /// Writes the values of [`Interpreted::evaluate`] that `kernel` sends to `buffer` into

@@ -180,4 +180,37 @@ mod tests {
             "{code}"
         );
     }
+
+    #[test]
+    fn a_fallible_method_answers_err_where_no_stage_or_view_serves() {
+        let mut one = Dispatch::default();
+        one.push(
+            1,
+            quote!(Self::factor_0(values, tiny, limit)),
+            &["values", "tiny"],
+        );
+        let params = [("values", quote!(&mut [f64])), ("tiny", quote!(f64))];
+        let result = Some(quote!(::core::result::Result<(), usize>));
+        let code = one
+            .method("factor", &params, result, false, &[])
+            .to_string();
+        assert!(
+            code.contains("if stage == 1 { Self :: factor_0 (values , tiny , limit) } else { :: core :: result :: Result :: Err (0) }"),
+            "{code}"
+        );
+        let mut view = Dispatch::default();
+        view.push(0, quote!(self.k(trig);), &["trig"]);
+        view.push(4, quote!(self.k(trig);), &["trig"]);
+        let params = [("trig", quote!(&mut [f64]))];
+        let three = idx(3);
+        let code = view
+            .method("fill", &params, None, false, &[("trig", &three)])
+            .to_string();
+        assert!(
+            code.contains(
+                "trig . first_chunk_mut :: < 3 > () else { trig . fill (f64 :: NAN) ; return ; }"
+            ),
+            "a mutable view, poisoned when short: {code}"
+        );
+    }
 }

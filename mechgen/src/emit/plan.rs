@@ -12,14 +12,20 @@ use super::idx;
 use super::lu::lu_functions;
 use super::stages::stage_table;
 use crate::expr::Id;
-use crate::plan::kernels::{Kernels, Method, StageKernel};
+use crate::plan::kernels::{Buffer, Kernels, Method, StageKernel};
 use crate::plan::structure::Plan;
 
 /// A `Structured` method written by the emitter: a kernel method, or one of the three that run
 /// a block's static LU.
 #[derive(Clone, Copy)]
 enum Item {
-    Kernels(Method),
+    Kernel(Method),
+    Lu(Lu),
+}
+
+/// The methods that run a block's static LU.
+#[derive(Clone, Copy)]
+enum Lu {
     Factor,
     Solve,
     SolveTranspose,
@@ -27,18 +33,18 @@ enum Item {
 
 /// The methods in the order generated code lists them.
 const ITEMS: [Item; 12] = [
-    Item::Kernels(Method::Positions),
-    Item::Kernels(Method::Velocities),
-    Item::Kernels(Method::Accelerations),
-    Item::Kernels(Method::Jacobian),
-    Item::Kernels(Method::FillTrig),
-    Item::Factor,
-    Item::Solve,
-    Item::SolveTranspose,
-    Item::Kernels(Method::VelocityRhs),
-    Item::Kernels(Method::AccelerationRhs),
-    Item::Kernels(Method::Multipliers),
-    Item::Kernels(Method::ForceRhs),
+    Item::Kernel(Method::Positions),
+    Item::Kernel(Method::Velocities),
+    Item::Kernel(Method::Accelerations),
+    Item::Kernel(Method::Jacobian),
+    Item::Kernel(Method::FillTrig),
+    Item::Lu(Lu::Factor),
+    Item::Lu(Lu::Solve),
+    Item::Lu(Lu::SolveTranspose),
+    Item::Kernel(Method::VelocityRhs),
+    Item::Kernel(Method::AccelerationRhs),
+    Item::Kernel(Method::Multipliers),
+    Item::Kernel(Method::ForceRhs),
 ];
 
 /// `impl Structured` and the inherent items it dispatches to.
@@ -56,8 +62,8 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan, kernels: &Kernels) 
     let methods = ITEMS.map(|item| {
         let (params, result, required) = signature(item);
         let dispatch = match item {
-            Item::Kernels(method) => kernel_dispatch(kernels, &functions, method),
-            _ => lu_dispatch(kernels, item),
+            Item::Kernel(method) => kernel_dispatch(kernels, &functions, method),
+            Item::Lu(lu) => lu_dispatch(kernels, lu),
         };
         dispatch.method(name_of(item), &params, result, required, &views)
     });
@@ -112,10 +118,18 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan, kernels: &Kernels) 
 /// The trait method's name.
 fn name_of(item: Item) -> &'static str {
     match item {
-        Item::Kernels(method) => method.info().trait_method,
-        Item::Factor => "factor",
-        Item::Solve => "solve",
-        Item::SolveTranspose => "solve_transpose",
+        Item::Kernel(Method::Positions) => "assign_positions",
+        Item::Kernel(Method::Velocities) => "assign_velocities",
+        Item::Kernel(Method::Accelerations) => "assign_accelerations",
+        Item::Kernel(Method::Jacobian) => "block_jacobian",
+        Item::Kernel(Method::VelocityRhs) => "velocity_rhs",
+        Item::Kernel(Method::AccelerationRhs) => "acceleration_rhs",
+        Item::Kernel(Method::FillTrig) => "fill_trig",
+        Item::Kernel(Method::Multipliers) => "assign_multipliers",
+        Item::Kernel(Method::ForceRhs) => "force_rhs",
+        Item::Lu(Lu::Factor) => "factor",
+        Item::Lu(Lu::Solve) => "solve",
+        Item::Lu(Lu::SolveTranspose) => "solve_transpose",
     }
 }
 
@@ -130,10 +144,10 @@ fn signature(item: Item) -> (Vec<(&'static str, TokenStream)>, Option<TokenStrea
     let (qd, qdd) = (("qd", vector.clone()), ("qdd", vector));
     let (t, out) = (("t", t), ("out", mut_slice.clone()));
     let params = match item {
-        Item::Kernels(Method::Positions) => vec![("q", mut_vector), trig, t],
-        Item::Kernels(Method::Velocities) => vec![q, trig, ("qd", mut_vector), t],
-        Item::Kernels(Method::Accelerations) => vec![q, trig, qd, ("qdd", mut_vector), t],
-        Item::Kernels(Method::Jacobian) => {
+        Item::Kernel(Method::Positions) => vec![("q", mut_vector), trig, t],
+        Item::Kernel(Method::Velocities) => vec![q, trig, ("qd", mut_vector), t],
+        Item::Kernel(Method::Accelerations) => vec![q, trig, qd, ("qdd", mut_vector), t],
+        Item::Kernel(Method::Jacobian) => {
             vec![
                 q,
                 trig,
@@ -142,16 +156,23 @@ fn signature(item: Item) -> (Vec<(&'static str, TokenStream)>, Option<TokenStrea
                 ("values", mut_slice),
             ]
         }
-        Item::Kernels(Method::FillTrig) => vec![q, ("trig", mut_slice)],
-        Item::Kernels(Method::VelocityRhs) => vec![q, trig, qd, t, out],
-        Item::Kernels(Method::AccelerationRhs) => vec![q, trig, qd, qdd, t, out],
-        Item::Kernels(Method::Multipliers) => vec![q, trig, qd, qdd, ("lambda", mut_slice), t],
-        Item::Kernels(Method::ForceRhs) => vec![q, trig, qd, qdd, ("lambda", slice), t, out],
-        Item::Factor => vec![("values", mut_slice), ("tiny", t.1), ("limit", quote!(f64))],
-        Item::Solve | Item::SolveTranspose => vec![("values", slice), ("x", mut_slice)],
+        Item::Kernel(Method::FillTrig) => vec![q, ("trig", mut_slice)],
+        Item::Kernel(Method::VelocityRhs) => vec![q, trig, qd, t, out],
+        Item::Kernel(Method::AccelerationRhs) => vec![q, trig, qd, qdd, t, out],
+        Item::Kernel(Method::Multipliers) => vec![q, trig, qd, qdd, ("lambda", mut_slice), t],
+        Item::Kernel(Method::ForceRhs) => vec![q, trig, qd, qdd, ("lambda", slice), t, out],
+        Item::Lu(Lu::Factor) => vec![
+            ("values", mut_slice),
+            ("tiny", quote!(f64)),
+            ("limit", quote!(f64)),
+        ],
+        Item::Lu(Lu::Solve) | Item::Lu(Lu::SolveTranspose) => {
+            vec![("values", slice), ("x", mut_slice)]
+        }
     };
-    let result = matches!(item, Item::Factor).then(|| quote!(::core::result::Result<(), usize>));
-    let required = matches!(item, Item::Kernels(Method::Positions | Method::Jacobian));
+    let result =
+        matches!(item, Item::Lu(Lu::Factor)).then(|| quote!(::core::result::Result<(), usize>));
+    let required = matches!(item, Item::Kernel(Method::Positions | Method::Jacobian));
     (params, result, required)
 }
 
@@ -203,7 +224,8 @@ fn kernel_function(cx: &Context<'_>, kernels: &Kernels, k: &StageKernel) -> (Tok
             (input, ty)
         })
         .collect();
-    let name = k.method.kernel_name(k.stage);
+    let (suffix, description) = naming(k.method);
+    let name = format!("stage_{}_{suffix}", k.stage);
     let f = cx.bounded(&name, &outputs, zeros, &outs, &typed, &k.kernel.cached);
     let mut params = Vec::new();
     let mut arguments = Vec::new();
@@ -221,10 +243,7 @@ fn kernel_function(cx: &Context<'_>, kernels: &Kernels, k: &StageKernel) -> (Tok
         arguments.push(*out);
     }
     let function = format_ident!("{}", name);
-    let (doc, body) = (
-        kernel_doc(k.stage, k.method.info().description, &f),
-        &f.body,
-    );
+    let (doc, body) = (kernel_doc(k.stage, description, &f), &f.body);
     let code = quote! {
         #doc
         fn #function(&self, #(#params),*) {
@@ -240,30 +259,45 @@ fn kernel_function(cx: &Context<'_>, kernels: &Kernels, k: &StageKernel) -> (Tok
     )
 }
 
-/// The output parameters of a kernel of `k`'s method, typed with their lengths.
+/// A kernel's name after `stage_s_`, and what it does (its documentation).
+fn naming(method: Method) -> (&'static str, &'static str) {
+    match method {
+        Method::Positions => ("positions", "assigns the positions"),
+        Method::Velocities => ("velocities", "assigns the velocities"),
+        Method::Accelerations => ("accelerations", "assigns the accelerations"),
+        Method::Jacobian => ("jacobian", "the block's residual and Jacobian values"),
+        Method::VelocityRhs => ("velocity_rhs", "the block's velocity right-hand side"),
+        Method::AccelerationRhs => (
+            "acceleration_rhs",
+            "the block's acceleration right-hand side",
+        ),
+        Method::FillTrig => ("trig", "caches the sines and cosines of its angles"),
+        Method::Multipliers => (
+            "multipliers",
+            "assigns its equations' multipliers (force solve)",
+        ),
+        Method::ForceRhs => ("force_rhs", "the block's force right-hand side"),
+    }
+}
+
+/// The output parameters of a kernel of `k`'s method: the state vector it writes, or arrays
+/// of the lengths the kernel list gives.
 fn output_parameters(
     cx: &Context<'_>,
     kernels: &Kernels,
     k: &StageKernel,
 ) -> Vec<(&'static str, TokenStream)> {
-    let shape = &kernels.shapes[k.stage];
-    let equations = idx(shape.equations.len());
-    let array = |len: proc_macro2::Literal| quote!(&mut [f64; #len]);
-    let target = k.method.target().name();
+    let array = |buffer: Buffer| {
+        let len = idx(kernels.buffer_len(k.stage, buffer));
+        (buffer.name(), quote!(&mut [f64; #len]))
+    };
     match k.method {
         Method::Positions | Method::Velocities | Method::Accelerations => {
             let vector = cx.vector_type();
-            vec![(target, quote!(&mut #vector))]
+            vec![(k.method.target().name(), quote!(&mut #vector))]
         }
-        Method::Jacobian => {
-            let slots = shape.block.as_ref().map_or(0, |b| b.slots);
-            vec![("phi", array(equations)), ("values", array(idx(slots)))]
-        }
-        Method::VelocityRhs | Method::AccelerationRhs | Method::ForceRhs => {
-            vec![("out", array(equations))]
-        }
-        Method::FillTrig => vec![("trig", array(idx(kernels.sizes.trig)))],
-        Method::Multipliers => vec![("lambda", array(idx(kernels.sizes.coordinates)))],
+        Method::Jacobian => vec![array(Buffer::Phi), array(Buffer::Values)],
+        method => vec![array(method.target())],
     }
 }
 
@@ -281,16 +315,13 @@ fn kernel_dispatch(
             continue;
         }
         let call = kernel.call();
-        let equations = idx(kernels.shapes[k.stage].equations.len());
+        let len = |buffer: Buffer| idx(kernels.buffer_len(k.stage, buffer));
+        let equations = len(Buffer::Out);
         let arm = match method {
             Method::Positions | Method::Velocities | Method::Accelerations => call,
             Method::FillTrig | Method::Multipliers => quote!(#call;),
             Method::Jacobian => {
-                let slots = kernels.shapes[k.stage]
-                    .block
-                    .as_ref()
-                    .map_or(0, |b| b.slots);
-                let slots = idx(slots);
+                let slots = len(Buffer::Values);
                 quote! {
                     let (#some(phi), #some(values)) =
                         (phi.first_chunk_mut::<#equations>(), values.first_chunk_mut::<#slots>())
@@ -317,7 +348,7 @@ fn kernel_dispatch(
 
 /// `factor`, `solve` or `solve_transpose`: each block with a static LU calls its shared
 /// functions over the block's value slots.
-fn lu_dispatch(kernels: &Kernels, item: Item) -> Dispatch {
+fn lu_dispatch(kernels: &Kernels, lu: Lu) -> Dispatch {
     let some = quote!(::core::option::Option::Some);
     let mut dispatch = Dispatch::default();
     for (s, shape) in kernels.shapes.iter().enumerate() {
@@ -329,8 +360,8 @@ fn lu_dispatch(kernels: &Kernels, item: Item) -> Dispatch {
             continue;
         };
         let (n, slots) = (idx(shape.equations.len()), idx(block.slots));
-        match item {
-            Item::Factor => {
+        match lu {
+            Lu::Factor => {
                 let factor = format_ident!("factor_{}", k);
                 dispatch.push(
                     s,
@@ -343,9 +374,9 @@ fn lu_dispatch(kernels: &Kernels, item: Item) -> Dispatch {
                     &["values", "tiny", "limit"],
                 );
             }
-            _ => {
-                let function = match item {
-                    Item::Solve => format_ident!("solve_{}", k),
+            Lu::Solve | Lu::SolveTranspose => {
+                let function = match lu {
+                    Lu::Solve => format_ident!("solve_{}", k),
                     _ => format_ident!("solve_transpose_{}", k),
                 };
                 dispatch.push(

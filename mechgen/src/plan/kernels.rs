@@ -57,86 +57,43 @@ impl Method {
         Method::ForceRhs,
     ];
 
-    /// The method's facts (one row of the table in this module).
-    pub fn info(self) -> &'static MethodInfo {
-        &METHODS[self as usize]
-    }
-
-    /// When the kernel runs: see [`MethodInfo::phase`].
+    /// When its kernels run, which decides the trig slots they may read ([`Phase::ready`]):
+    /// a stage's positions, Jacobian and the sines it fills only from earlier stages, its
+    /// rates also from its own, the force solve from every stage.
     pub fn phase(self) -> Phase {
-        self.info().phase
+        match self {
+            Method::Positions | Method::Jacobian | Method::FillTrig => Phase::Positions,
+            Method::Velocities
+            | Method::Accelerations
+            | Method::VelocityRhs
+            | Method::AccelerationRhs => Phase::After,
+            Method::Multipliers | Method::ForceRhs => Phase::Final,
+        }
     }
 
     /// The state its kernels may read besides the trig cache and time.
     pub fn inputs(self) -> &'static [Input] {
-        self.info().inputs
+        match self {
+            Method::Positions | Method::Jacobian | Method::FillTrig => &[Input::Q],
+            Method::Velocities | Method::VelocityRhs => &[Input::Q, Input::Qd],
+            Method::Accelerations | Method::AccelerationRhs => &[Input::Q, Input::Qd, Input::Qdd],
+            Method::Multipliers | Method::ForceRhs => {
+                &[Input::Q, Input::Qd, Input::Qdd, Input::Lambda]
+            }
+        }
     }
 
     /// The buffer its kernels write (a block's Jacobian also writes [`Buffer::Phi`]).
     pub fn target(self) -> Buffer {
-        self.info().target
-    }
-
-    /// The kernel's name in stage `s` (`stage_3_positions`).
-    pub fn kernel_name(self, s: usize) -> String {
-        format!("stage_{s}_{}", self.info().suffix)
-    }
-}
-
-/// What a consumer needs to know about a [`Method`].
-#[derive(Debug)]
-pub struct MethodInfo {
-    /// The `Structured` method's name.
-    pub trait_method: &'static str,
-    /// Its kernels' names after `stage_s_`.
-    pub suffix: &'static str,
-    /// What its kernels do, for their documentation.
-    pub description: &'static str,
-    /// When it runs, which decides the trig slots it may read: a stage's positions (and the
-    /// sines it fills) only from earlier stages, its rates also from its own, the force solve
-    /// from every stage.
-    pub phase: Phase,
-    /// The state it reads besides the trig cache and time.
-    pub inputs: &'static [Input],
-    /// The buffer it writes.
-    pub target: Buffer,
-}
-
-const POSITIONS: &[Input] = &[Input::Q];
-const VELOCITIES: &[Input] = &[Input::Q, Input::Qd];
-const ACCELERATIONS: &[Input] = &[Input::Q, Input::Qd, Input::Qdd];
-const FORCES: &[Input] = &[Input::Q, Input::Qd, Input::Qdd, Input::Lambda];
-
-/// The methods' facts, in [`Method::ALL`] order.
-#[rustfmt::skip]
-const METHODS: [MethodInfo; 9] = [
-    //   trait method            kernel suffix       description                                          phase             reads          writes
-    info("assign_positions",     "positions",        "assigns the positions",                             Phase::Positions, POSITIONS,     Buffer::Q),
-    info("assign_velocities",    "velocities",       "assigns the velocities",                            Phase::After,     VELOCITIES,    Buffer::Qd),
-    info("assign_accelerations", "accelerations",    "assigns the accelerations",                         Phase::After,     ACCELERATIONS, Buffer::Qdd),
-    info("block_jacobian",       "jacobian",         "the block's residual and Jacobian values",          Phase::Positions, POSITIONS,     Buffer::Values),
-    info("velocity_rhs",         "velocity_rhs",     "the block's velocity right-hand side",              Phase::After,     VELOCITIES,    Buffer::Out),
-    info("acceleration_rhs",     "acceleration_rhs", "the block's acceleration right-hand side",          Phase::After,     ACCELERATIONS, Buffer::Out),
-    info("fill_trig",            "trig",             "caches the sines and cosines of its angles",        Phase::Positions, POSITIONS,     Buffer::Trig),
-    info("assign_multipliers",   "multipliers",      "assigns its equations' multipliers (force solve)",  Phase::Final,     FORCES,        Buffer::Lambda),
-    info("force_rhs",            "force_rhs",        "the block's force right-hand side",                 Phase::Final,     FORCES,        Buffer::Out),
-];
-
-const fn info(
-    trait_method: &'static str,
-    suffix: &'static str,
-    description: &'static str,
-    phase: Phase,
-    inputs: &'static [Input],
-    target: Buffer,
-) -> MethodInfo {
-    MethodInfo {
-        trait_method,
-        suffix,
-        description,
-        phase,
-        inputs,
-        target,
+        match self {
+            Method::Positions => Buffer::Q,
+            Method::Velocities => Buffer::Qd,
+            Method::Accelerations => Buffer::Qdd,
+            Method::Jacobian => Buffer::Values,
+            Method::VelocityRhs | Method::AccelerationRhs | Method::ForceRhs => Buffer::Out,
+            Method::FillTrig => Buffer::Trig,
+            Method::Multipliers => Buffer::Lambda,
+        }
     }
 }
 
@@ -315,6 +272,19 @@ impl Kernels {
         self.stages.iter().filter(move |k| k.method == method)
     }
 
+    /// The length of `buffer` as stage `s`'s kernels see it: a state vector or the
+    /// multipliers, one per coordinate; the trig cache; a block's residuals or right-hand
+    /// side, one per equation; its value slots.
+    pub fn buffer_len(&self, s: usize, buffer: Buffer) -> usize {
+        let shape = self.shapes.get(s);
+        match buffer {
+            Buffer::Q | Buffer::Qd | Buffer::Qdd | Buffer::Lambda => self.sizes.coordinates,
+            Buffer::Trig => self.sizes.trig,
+            Buffer::Phi | Buffer::Out => shape.map_or(0, |s| s.equations.len()),
+            Buffer::Values => shape.and_then(|s| s.block.as_ref()).map_or(0, |b| b.slots),
+        }
+    }
+
     /// The static LU of stage `s`, if it is a block that has one.
     pub fn factorization(&self, s: usize) -> Option<&Factorization> {
         let index = self.shapes.get(s)?.block.as_ref()?.factorization?;
@@ -322,10 +292,11 @@ impl Kernels {
     }
 }
 
-/// The kernels of `plan` (and of the force solve, for a scene that computes forces); `markers`
-/// and `branches` are the scene's marker values and branch invariants.
+/// The kernels of `plan` (and of the force solve, for a scene that computes forces) over `dim`
+/// coordinates; `markers` and `branches` are the scene's marker values and branch invariants.
 pub fn list(
     arena: &Arena,
+    dim: usize,
     plan: &Plan,
     forces: Option<&Forces>,
     markers: &[Id],
@@ -354,7 +325,6 @@ pub fn list(
         .iter()
         .map(|&b| Kernel::listed(arena, plan, &[b], all_filled, Phase::Positions))
         .collect();
-    let dim = plan.stages.iter().map(stage_len).sum();
     let sizes = Sizes {
         largest_block: plan.largest_block(),
         largest_slots: plan.largest_slots(),
@@ -521,18 +491,11 @@ fn shape<'p>(plan: &'p Plan, s: usize, factorizations: &mut Factorizations<'p>) 
     }
 }
 
-/// The coordinates a stage solves for.
-fn stage_len(stage: &Stage) -> usize {
-    match stage {
-        Stage::Explicit(assignments) => assignments.len(),
-        Stage::Block(block) => block.coordinates.len(),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::Scene;
+    use crate::expr::{Func, Node, Var, var_index};
 
     fn scene(source: &str) -> Scene {
         crate::compile(crate::Input::Text(source), &crate::Options::default())
@@ -560,20 +523,6 @@ mod tests {
         driver d2: angle(c2) = 2 * t;
     }";
 
-    /// The facts table is indexed by the method: a row out of place would give a kernel
-    /// another method's phase, inputs or name.
-    #[test]
-    fn the_method_table_is_in_method_order() {
-        for (i, method) in Method::ALL.into_iter().enumerate() {
-            assert_eq!(method as usize, i);
-            let debug = format!("{method:?}").to_lowercase();
-            let info = method.info();
-            let named = info.trait_method.replace('_', "");
-            let found = named.contains(&debug) || debug.contains(info.suffix.trim_end_matches('s'));
-            assert!(found, "{method:?} has the row of {}", info.trait_method);
-        }
-    }
-
     /// A kernel of stage `s` reads a cached sine only once it is filled: positions from
     /// earlier stages, rates from earlier stages and its own, the force solve from any.
     #[test]
@@ -585,10 +534,15 @@ mod tests {
             for k in &scene.kernels.stages {
                 for &slot in k.kernel.cached.values() {
                     let filled = trig.filled_by[slot / 2];
-                    let allowed = match k.method.phase() {
-                        Phase::Positions => filled < k.stage,
-                        Phase::After => filled <= k.stage,
-                        Phase::Final => true,
+                    // Written out per method, not read from `Method::phase`: the rule itself
+                    // is what is tested.
+                    let allowed = match k.method {
+                        Method::Positions | Method::Jacobian | Method::FillTrig => filled < k.stage,
+                        Method::Velocities
+                        | Method::Accelerations
+                        | Method::VelocityRhs
+                        | Method::AccelerationRhs => filled <= k.stage,
+                        Method::Multipliers | Method::ForceRhs => true,
                     };
                     assert!(
                         allowed,
@@ -658,14 +612,22 @@ mod tests {
                     assert_eq!(k.kernel.roots.len(), block.equations.len());
                 }
                 (_, Method::FillTrig) => {
-                    let slots: Vec<usize> = scene
-                        .plan
-                        .trig
+                    let trig = &scene.plan.trig;
+                    let slots: Vec<usize> = trig
                         .fills(k.stage)
                         .flat_map(|m| [2 * m, 2 * m + 1])
                         .collect();
                     let written: Vec<usize> = k.kernel.outputs.iter().map(|o| o.1).collect();
                     assert_eq!(written, slots);
+                    // Each value lands in its own node's slot: a sine where sines are read.
+                    for (&root, &(buffer, slot)) in k.kernel.roots.iter().zip(&k.kernel.outputs) {
+                        assert_eq!((buffer, Some(&slot)), (Buffer::Trig, trig.slot.get(&root)));
+                        let angle = trig.angles[slot / 2];
+                        let q = scene.model.arena.find(Node::Var(Var::Q(var_index(angle))));
+                        let func = if slot % 2 == 0 { Func::Sin } else { Func::Cos };
+                        let node = q.and_then(|q| scene.model.arena.find(Node::Call(func, q)));
+                        assert_eq!(node, Some(root), "slot {slot} holds {func:?} of q{angle}");
+                    }
                 }
                 (stage, method) => panic!("{method:?} in {stage:?}"),
             }
@@ -691,6 +653,43 @@ mod tests {
         let archive: usize = forces.plan.blocks().map(|b| b.slots()).sum();
         assert_eq!(forces.kernels.sizes.forces, Some(dim + archive));
         assert_eq!(forces.kernels.sizes.coordinates, dim);
+    }
+
+    /// LUs are numbered in order of first use: a four-bar's block and a slider-crank's are
+    /// two patterns, the second four-bar's shares the first's.
+    #[test]
+    fn static_lus_are_numbered_by_first_use() {
+        let source = TWIN_FOUR_BARS.replace(
+            "driver d2: angle(c2) = 2 * t;",
+            "driver d2: angle(c2) = 2 * t;
+            body crank near (0, 0, 0);
+            body slider near (130, 500, 0);
+            joint main: revolute(frame @ (0, 500), crank);
+            joint rod: distance(crank @ (40, 0), slider, 100);
+            joint line: prismatic(frame @ (0, 500), slider, along (1, 0));
+            driver spin: angle(crank) = 3 * t;",
+        );
+        let scene = scene(&source);
+        let numbers: Vec<Option<usize>> = scene
+            .kernels
+            .shapes
+            .iter()
+            .filter_map(|s| s.block.as_ref().map(|b| b.factorization))
+            .collect();
+        let distinct = scene.kernels.factorizations.len();
+        assert_eq!(distinct, 2, "{numbers:?}");
+        let mut first_use = Vec::new();
+        for n in numbers.iter().flatten() {
+            if !first_use.contains(n) {
+                first_use.push(*n);
+            }
+        }
+        assert_eq!(
+            first_use,
+            [0, 1],
+            "numbered in order of first use: {numbers:?}"
+        );
+        assert_eq!(numbers.iter().flatten().filter(|&&n| n == 0).count(), 2);
     }
 
     /// Blocks of one pattern share one static LU; the shape of each block points at it.
