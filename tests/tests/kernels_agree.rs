@@ -8,7 +8,7 @@
 use mechgen_examples::scenes::{FourBar, PistonCrankDynamics};
 use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::Const;
-use mechgen_runtime::{Mechanism, Storage, Structured, Vector};
+use mechgen_runtime::{Storage, Structured, Vector};
 
 /// What an untouched entry holds.
 const SENTINEL: f64 = 7.25e101;
