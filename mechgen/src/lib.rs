@@ -107,23 +107,15 @@ pub fn compile(input: Input<'_>, options: &Options) -> Result<Scene, Errors> {
 /// forces its dynamics and the force solve's structure.
 fn scene(mut model: Model) -> Scene {
     let kinematics = kinematics::derive(&mut model);
-    let mut plan = structure::plan(&mut model, &kinematics);
+    let plan = structure::plan(&mut model, &kinematics);
     let forces = (model.outputs >= model::Outputs::Forces).then(|| {
         let generalized = dynamics::derive(&mut model);
-        let forces = reactions::plan(&mut model, &kinematics, &plan, generalized);
-        let reads: Vec<expr::Id> = kinematics
-            .markers
-            .iter()
-            .chain(forces.kernel_roots())
-            .copied()
-            .collect();
-        let n = model.dim();
-        plan.cache_final_reads(&mut model.arena, n, &reads);
-        forces
+        reactions::plan(&mut model, &kinematics, &plan, generalized)
     });
+    let dim = model.dim();
     let kernels = kernels::list(
-        &model.arena,
-        model.dim(),
+        &mut model.arena,
+        dim,
         &plan,
         forces.as_ref(),
         &kinematics.markers,

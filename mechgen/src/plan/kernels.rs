@@ -8,14 +8,16 @@
 //! its stages; the interpreter (crate `mechgen-interp`) compiles each kernel into a tape and
 //! each method into a table lookup. Neither decides anything this module has not: which phase
 //! a level runs in (so which trig slots it may read), a block's roots (residuals, then the
-//! Jacobian's entries), which static LU a block shares, which stages have a force kernel, the
-//! workspace's sizes.
+//! Jacobian's entries), which angles the trig cache holds (planned here from the kernels
+//! themselves, `trig`), which static LU a block shares, which stages have a force kernel, the
+//! buffers' lengths and the workspace's sizes.
 
 use std::collections::HashMap;
 
 use crate::expr::{Arena, Id};
 use crate::plan::reactions::{ForceStage, Forces};
-use crate::plan::structure::{Phase, Plan, Stage};
+use crate::plan::structure::{Assignment, Block, Plan, Stage};
+use crate::plan::trig::{self, Phase, TrigCache};
 use crate::sparse::factor::Factorization;
 
 /// A kind of per-stage kernel: the `Structured` method that runs it.
@@ -171,28 +173,32 @@ pub struct Kernel {
 }
 
 impl Kernel {
-    /// A kernel whose `i`-th value goes to `out[i]`.
-    fn listed(arena: &Arena, plan: &Plan, roots: &[Id], stage: usize, phase: Phase) -> Self {
-        let outputs = (0..roots.len()).map(|i| (Buffer::Out, i)).collect();
-        Kernel::new(arena, plan, roots.to_vec(), outputs, stage, phase)
-    }
-
+    /// The kernel of `roots` writing `outputs`, run by stage `stage` in `phase`: it reads the
+    /// cached sines and cosines that are filled by then.
     fn new(
         arena: &Arena,
-        plan: &Plan,
-        roots: Vec<Id>,
-        outputs: Vec<(Buffer, usize)>,
+        trig: &TrigCache,
+        (roots, outputs): Draft,
         stage: usize,
         phase: Phase,
     ) -> Self {
-        let cached = plan.trig.reads(arena, &roots, stage, phase);
+        let cached = trig.reads(arena, &roots, stage, phase);
         Kernel {
             roots,
             outputs,
             cached,
         }
     }
+
+    /// A kernel whose `i`-th value goes to `out[i]`, run after stage `stage - 1`.
+    fn listed(arena: &Arena, trig: &TrigCache, roots: &[Id], stage: usize, phase: Phase) -> Self {
+        let outputs = (0..roots.len()).map(|i| (Buffer::Out, i)).collect();
+        Kernel::new(arena, trig, (roots.to_vec(), outputs), stage, phase)
+    }
 }
+
+/// A kernel before the trig cache is planned: its roots and where each value goes.
+type Draft = (Vec<Id>, Vec<(Buffer, usize)>);
 
 /// A kernel of one stage, run by one method.
 #[derive(Debug, Clone)]
@@ -262,6 +268,8 @@ pub struct Kernels {
     pub markers: Option<Kernel>,
     /// Each branch invariant at the solved positions, reading the trig cache.
     pub branches: Vec<Kernel>,
+    /// The trig cache the kernels fill and read, planned from them.
+    pub trig: TrigCache,
     /// The workspace.
     pub sizes: Sizes,
 }
@@ -294,43 +302,62 @@ impl Kernels {
 
 /// The kernels of `plan` (and of the force solve, for a scene that computes forces) over `dim`
 /// coordinates; `markers` and `branches` are the scene's marker values and branch invariants.
+///
+/// In three passes: what each stage computes; the trig cache, planned from those kernels and
+/// the markers (the sine and cosine nodes it needs are added to the arena); then each stage's
+/// trig fill, and what every kernel reads from the cache.
 pub fn list(
-    arena: &Arena,
+    arena: &mut Arena,
     dim: usize,
     plan: &Plan,
     forces: Option<&Forces>,
     markers: &[Id],
     branches: &[Id],
 ) -> Kernels {
-    let mut factorizations = Factorizations::default();
-    let mut stages = Vec::new();
-    let mut shapes = Vec::new();
-    for s in 0..plan.stages.len() {
-        let force = forces.map(|f| &f.stages[s]);
-        stages.extend(
-            stage_kernels(arena, plan, s, force)
-                .into_iter()
-                .map(|(method, kernel)| StageKernel {
-                    stage: s,
-                    method,
-                    kernel,
-                }),
-        );
-        shapes.push(shape(plan, s, &mut factorizations));
-    }
+    let drafts: Vec<Vec<(Method, Draft)>> = (0..plan.stages.len())
+        .map(|s| stage_drafts(plan, s, forces.map(|f| &f.stages[s])))
+        .collect();
     let all_filled = plan.stages.len();
+    // The naive baseline caches nothing: it is the code without this saving.
+    let trig = if arena.simplifies() {
+        let stage_kernels = drafts.iter().enumerate().flat_map(|(s, kernels)| {
+            kernels
+                .iter()
+                .map(move |(method, (roots, _))| (s, method.phase(), &roots[..]))
+        });
+        let after_sweep = (all_filled, Phase::Final, markers);
+        trig::plan(arena, &plan.stages, dim, stage_kernels.chain([after_sweep]))
+    } else {
+        TrigCache::default()
+    };
+    let arena = &*arena;
+    let mut stages = Vec::new();
+    for (s, kernels) in drafts.into_iter().enumerate() {
+        let fill = fill_draft(&trig, s).map(|draft| (Method::FillTrig, draft));
+        let mut kernels: Vec<(Method, Draft)> = kernels.into_iter().chain(fill).collect();
+        kernels.sort_by_key(|(method, _)| *method);
+        stages.extend(kernels.into_iter().map(|(method, draft)| StageKernel {
+            stage: s,
+            method,
+            kernel: Kernel::new(arena, &trig, draft, s, method.phase()),
+        }));
+    }
+    let mut factorizations = Factorizations::default();
+    let shapes = (0..plan.stages.len())
+        .map(|s| shape(plan, s, &mut factorizations))
+        .collect();
     let markers = (!markers.is_empty())
-        .then(|| Kernel::listed(arena, plan, markers, all_filled, Phase::Final));
+        .then(|| Kernel::listed(arena, &trig, markers, all_filled, Phase::Final));
     let branches = branches
         .iter()
-        .map(|&b| Kernel::listed(arena, plan, &[b], all_filled, Phase::Positions))
+        .map(|&b| Kernel::listed(arena, &trig, &[b], all_filled, Phase::Positions))
         .collect();
     let sizes = Sizes {
         largest_block: plan.largest_block(),
         largest_slots: plan.largest_slots(),
         stages: plan.stages.len().max(1),
         coordinates: dim,
-        trig: plan.trig.len(),
+        trig: trig.len(),
         forces: forces.map(|_| dim + plan.blocks().map(|b| b.slots()).sum::<usize>()),
     };
     Kernels {
@@ -339,88 +366,18 @@ pub fn list(
         factorizations: factorizations.order.into_iter().cloned().collect(),
         markers,
         branches,
+        trig,
         sizes,
     }
 }
 
-/// Stage `s`'s kernels in [`Method`] order: its levels or its block's, the trig it fills, its
-/// force kernel.
-fn stage_kernels(
-    arena: &Arena,
-    plan: &Plan,
-    s: usize,
-    force: Option<&ForceStage>,
-) -> Vec<(Method, Kernel)> {
-    let kernel = |method: Method, roots: Vec<Id>, outputs: Vec<(Buffer, usize)>| {
-        (
-            method,
-            Kernel::new(arena, plan, roots, outputs, s, method.phase()),
-        )
+/// What stage `s` computes, but for the trig it fills: its levels or its block's kernels, and
+/// its force kernel.
+fn stage_drafts(plan: &Plan, s: usize, force: Option<&ForceStage>) -> Vec<(Method, Draft)> {
+    let mut kernels = match &plan.stages[s] {
+        Stage::Explicit(assignments) => level_drafts(assignments),
+        Stage::Block(block) => block_drafts(block),
     };
-    let mut kernels = Vec::new();
-    match &plan.stages[s] {
-        Stage::Explicit(assignments) => {
-            let coordinates: Vec<usize> = assignments.iter().map(|a| a.coordinate).collect();
-            let levels = [
-                (
-                    Method::Positions,
-                    Some(assignments.iter().map(|a| a.position).collect()),
-                ),
-                (
-                    Method::Velocities,
-                    assignments.iter().map(|a| a.velocity).collect(),
-                ),
-                (
-                    Method::Accelerations,
-                    assignments.iter().map(|a| a.acceleration).collect(),
-                ),
-            ];
-            for (method, roots) in levels {
-                // A level the scene does not compute has no kernel.
-                let Some(roots) = roots else { continue };
-                let target = method.target();
-                let outputs = coordinates.iter().map(|&c| (target, c)).collect();
-                kernels.push(kernel(method, roots, outputs));
-            }
-        }
-        Stage::Block(block) => {
-            let roots = block
-                .residuals
-                .iter()
-                .copied()
-                .chain(block.entries.iter().map(|e| e.2))
-                .collect();
-            let outputs = (0..block.residuals.len())
-                .map(|r| (Buffer::Phi, r))
-                .chain((0..block.entries.len()).map(|k| (Buffer::Values, k)))
-                .collect();
-            kernels.push(kernel(Method::Jacobian, roots, outputs));
-            let rates = [
-                (Method::VelocityRhs, &block.velocity_rhs),
-                (Method::AccelerationRhs, &block.acceleration_rhs),
-            ];
-            for (method, roots) in rates {
-                let Some(roots) = roots else { continue };
-                let outputs = (0..roots.len()).map(|r| (Buffer::Out, r)).collect();
-                kernels.push(kernel(method, roots.clone(), outputs));
-            }
-        }
-    }
-    let fills: Vec<usize> = plan.trig.fills(s).collect();
-    if !fills.is_empty() {
-        let roots = fills
-            .iter()
-            .flat_map(|&m| {
-                let (sin, cos) = plan.trig.nodes[m];
-                [sin, cos]
-            })
-            .collect();
-        let outputs = fills
-            .iter()
-            .flat_map(|&m| [(Buffer::Trig, 2 * m), (Buffer::Trig, 2 * m + 1)])
-            .collect();
-        kernels.push(kernel(Method::FillTrig, roots, outputs));
-    }
     match (&plan.stages[s], force) {
         (_, None) => {}
         (Stage::Explicit(assignments), Some(ForceStage::Explicit(values))) => {
@@ -428,15 +385,87 @@ fn stage_kernels(
                 .iter()
                 .map(|a| (Buffer::Lambda, a.equation))
                 .collect();
-            kernels.push(kernel(Method::Multipliers, values.clone(), outputs));
+            kernels.push((Method::Multipliers, (values.clone(), outputs)));
         }
         (Stage::Block(_), Some(ForceStage::Block(values))) => {
             let outputs = (0..values.len()).map(|j| (Buffer::Out, j)).collect();
-            kernels.push(kernel(Method::ForceRhs, values.clone(), outputs));
+            kernels.push((Method::ForceRhs, (values.clone(), outputs)));
         }
         _ => unreachable!("the force plan follows the kinematic plan stage for stage"),
     }
     kernels
+}
+
+/// An explicit stage's positions, velocities and accelerations, each written to its
+/// coordinates (a level the scene does not compute has no kernel).
+fn level_drafts(assignments: &[Assignment]) -> Vec<(Method, Draft)> {
+    let levels = [
+        (
+            Method::Positions,
+            Some(assignments.iter().map(|a| a.position).collect()),
+        ),
+        (
+            Method::Velocities,
+            assignments.iter().map(|a| a.velocity).collect(),
+        ),
+        (
+            Method::Accelerations,
+            assignments.iter().map(|a| a.acceleration).collect(),
+        ),
+    ];
+    levels
+        .into_iter()
+        .filter_map(|(method, roots): (Method, Option<Vec<Id>>)| {
+            let target = method.target();
+            let outputs = assignments.iter().map(|a| (target, a.coordinate)).collect();
+            Some((method, (roots?, outputs)))
+        })
+        .collect()
+}
+
+/// A block's residuals then Jacobian values, and its rate right-hand sides.
+fn block_drafts(block: &Block) -> Vec<(Method, Draft)> {
+    let roots = block
+        .residuals
+        .iter()
+        .copied()
+        .chain(block.entries.iter().map(|e| e.2))
+        .collect();
+    let outputs = (0..block.residuals.len())
+        .map(|r| (Buffer::Phi, r))
+        .chain((0..block.entries.len()).map(|k| (Buffer::Values, k)))
+        .collect();
+    let mut kernels = vec![(Method::Jacobian, (roots, outputs))];
+    let rates = [
+        (Method::VelocityRhs, &block.velocity_rhs),
+        (Method::AccelerationRhs, &block.acceleration_rhs),
+    ];
+    for (method, roots) in rates {
+        let Some(roots) = roots else { continue };
+        let outputs = (0..roots.len()).map(|r| (Buffer::Out, r)).collect();
+        kernels.push((method, (roots.clone(), outputs)));
+    }
+    kernels
+}
+
+/// The sines and cosines stage `s` fills into the cache, if any.
+fn fill_draft(trig: &TrigCache, s: usize) -> Option<Draft> {
+    let fills: Vec<usize> = trig.fills(s).collect();
+    if fills.is_empty() {
+        return None;
+    }
+    let roots = fills
+        .iter()
+        .flat_map(|&m| {
+            let (sin, cos) = trig.nodes[m];
+            [sin, cos]
+        })
+        .collect();
+    let outputs = fills
+        .iter()
+        .flat_map(|&m| [(Buffer::Trig, 2 * m), (Buffer::Trig, 2 * m + 1)])
+        .collect();
+    Some((roots, outputs))
 }
 
 /// The distinct static LUs, numbered in order of first use.
@@ -529,7 +558,7 @@ mod tests {
     fn kernels_read_only_the_trig_slots_their_phase_allows() {
         for source in [FOUR_BAR, DYNAMICS, TWIN_FOUR_BARS] {
             let scene = scene(source);
-            let trig = &scene.plan.trig;
+            let trig = &scene.kernels.trig;
             let mut checked = 0;
             for k in &scene.kernels.stages {
                 for &slot in k.kernel.cached.values() {
@@ -612,7 +641,7 @@ mod tests {
                     assert_eq!(k.kernel.roots.len(), block.equations.len());
                 }
                 (_, Method::FillTrig) => {
-                    let trig = &scene.plan.trig;
+                    let trig = &scene.kernels.trig;
                     let slots: Vec<usize> = trig
                         .fills(k.stage)
                         .flat_map(|m| [2 * m, 2 * m + 1])

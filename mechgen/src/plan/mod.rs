@@ -8,5 +8,6 @@ pub mod reactions;
 pub mod scene;
 pub mod stats;
 pub mod structure;
+pub mod trig;
 
 pub use scene::Scene;

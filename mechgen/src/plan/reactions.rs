@@ -59,13 +59,6 @@ pub enum ForceStage {
 }
 
 impl Forces {
-    /// The expressions of the force solve's kernels (run after the forward sweep).
-    pub fn kernel_roots(&self) -> impl Iterator<Item = &Id> {
-        self.stages.iter().flat_map(|stage| match stage {
-            ForceStage::Explicit(values) | ForceStage::Block(values) => values,
-        })
-    }
-
     /// The non-zero outputs of the textbook force functions, by name (for operation counts).
     pub fn function_outputs(&self, arena: &Arena) -> Vec<(&'static str, Vec<Id>)> {
         let nonzero = |ids: &[Id]| -> Vec<Id> {

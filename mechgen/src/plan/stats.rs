@@ -275,8 +275,12 @@ fn summary(scene: &Scene) -> String {
         } else {
             String::new()
         },
-        plan.trig.angles.len(),
-        if plan.trig.angles.len() == 1 { "" } else { "s" },
+        scene.kernels.trig.angles.len(),
+        if scene.kernels.trig.angles.len() == 1 {
+            ""
+        } else {
+            "s"
+        },
     );
     if scene.forces.is_some() {
         out += &format!(

@@ -25,7 +25,7 @@ use std::collections::HashMap;
 
 use crate::expr::diff::Differentiator;
 use crate::expr::tape::{Inputs, Tape};
-use crate::expr::{Arena, Func, Id, Node, Var, var_index};
+use crate::expr::{Arena, Id, Var, var_index};
 use crate::model::kinematics::Kinematics;
 use crate::model::{Model, Outputs};
 use crate::sparse::factor::{self, Factorization};
@@ -44,77 +44,6 @@ pub struct Plan {
     /// For each stage, the earlier stages whose coordinates it reads, ascending (a singular
     /// stage leaves the coordinates of every stage downstream of it undetermined too).
     pub reads: Vec<Vec<usize>>,
-    /// Sines and cosines computed once per solve, when their angle is solved.
-    pub trig: TrigCache,
-}
-
-/// The solve's trig cache: the sine and cosine of each angle a later kernel needs, computed once
-/// (one `sincos`) right after the stage that determines the angle, and read from the cache by
-/// every kernel that runs after that (later stages, and the stage's own rates). Without it, a
-/// seed step computed sin and cos of the rod angle in six kernels.
-#[derive(Debug, Clone, Default)]
-pub struct TrigCache {
-    /// Slot `m` holds the sine (at `2m`) and cosine (at `2m + 1`) of coordinate `angles[m]`.
-    pub angles: Vec<usize>,
-    /// The nodes `sin q_k` and `cos q_k` of each slot.
-    pub nodes: Vec<(Id, Id)>,
-    /// The stage that fills each slot.
-    pub filled_by: Vec<usize>,
-    /// The slot of each cached node (`sin q_k` at `2m`, `cos q_k` at `2m + 1`).
-    pub slot: HashMap<Id, usize>,
-}
-
-/// When a kernel of a stage runs: before the stage's positions are known (explicit positions,
-/// a block's Newton iteration), after (its rates, its trig fill), or after the whole forward
-/// sweep (the force solve, in reverse).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Phase {
-    /// Computing the stage's positions.
-    Positions,
-    /// After the stage's positions are known.
-    After,
-    /// After every stage's positions are known: the whole cache is filled.
-    Final,
-}
-
-impl TrigCache {
-    /// Length of the cache buffer.
-    pub fn len(&self) -> usize {
-        2 * self.angles.len()
-    }
-
-    /// True without cached angles.
-    pub fn is_empty(&self) -> bool {
-        self.angles.is_empty()
-    }
-
-    /// The slots stage `stage` fills.
-    pub fn fills(&self, stage: usize) -> impl Iterator<Item = usize> + '_ {
-        (0..self.angles.len()).filter(move |&m| self.filled_by[m] == stage)
-    }
-
-    /// The cached nodes among those reachable from `roots` that a kernel of `stage` running in
-    /// `phase` reads from the cache, with their position in the buffer.
-    pub fn reads(
-        &self,
-        arena: &Arena,
-        roots: &[Id],
-        stage: usize,
-        phase: Phase,
-    ) -> HashMap<Id, usize> {
-        let ready = |m: usize| match phase {
-            Phase::Positions => self.filled_by[m] < stage,
-            Phase::After => self.filled_by[m] <= stage,
-            Phase::Final => true,
-        };
-        crate::expr::tape::topological_order(arena, roots)
-            .into_iter()
-            .filter_map(|id| {
-                let &i = self.slot.get(&id)?;
-                ready(i / 2).then_some((id, i))
-            })
-            .collect()
-    }
 }
 
 /// One stage of the solve.
@@ -249,113 +178,7 @@ pub fn plan(model: &mut Model, kin: &Kinematics) -> Plan {
         }
     }
     let reads = reads(cx.arena, &stages, n);
-    let trig = trig_cache(cx.arena, &stages, n, &kin.markers);
-    Plan {
-        stages,
-        reads,
-        trig,
-    }
-}
-
-impl Plan {
-    /// Re-plans the trig cache so that kernels run after the whole forward sweep (`Final`:
-    /// the markers, the force solve) also find the angles they alone read.
-    pub fn cache_final_reads(&mut self, arena: &mut Arena, n: usize, roots: &[Id]) {
-        self.trig = trig_cache(arena, &self.stages, n, roots);
-    }
-}
-
-/// The kernels of a stage, by the phase they run in.
-fn kernel_roots(stage: &Stage) -> [(Phase, Vec<Id>); 2] {
-    match stage {
-        Stage::Explicit(assignments) => [
-            (
-                Phase::Positions,
-                assignments.iter().map(|a| a.position).collect(),
-            ),
-            (
-                Phase::After,
-                assignments
-                    .iter()
-                    .flat_map(|a| a.velocity.into_iter().chain(a.acceleration))
-                    .collect(),
-            ),
-        ],
-        Stage::Block(block) => [
-            (
-                Phase::Positions,
-                block
-                    .residuals
-                    .iter()
-                    .copied()
-                    .chain(block.entries.iter().map(|e| e.2))
-                    .collect(),
-            ),
-            (
-                Phase::After,
-                block
-                    .velocity_rhs
-                    .iter()
-                    .chain(&block.acceleration_rhs)
-                    .flatten()
-                    .copied()
-                    .collect(),
-            ),
-        ],
-    }
-}
-
-/// The angles worth caching: those whose sine or cosine a kernel reads after the angle's stage
-/// is solved, the stages' kernels and the kernels of `final_roots` (run after the sweep).
-fn trig_cache(arena: &mut Arena, stages: &[Stage], n: usize, final_roots: &[Id]) -> TrigCache {
-    let mut stage_of = vec![0; n];
-    for (s, stage) in stages.iter().enumerate() {
-        for c in stage_coordinates(stage) {
-            stage_of[c] = s;
-        }
-    }
-    let mut wanted = vec![false; n];
-    let final_kernels = (stages.len(), (Phase::Final, final_roots.to_vec()));
-    let kernels = stages
-        .iter()
-        .enumerate()
-        .flat_map(|(s, stage)| kernel_roots(stage).map(|k| (s, k)))
-        .chain([final_kernels]);
-    for (s, (phase, roots)) in kernels {
-        for id in crate::expr::tape::topological_order(arena, &roots) {
-            if let Node::Call(Func::Sin | Func::Cos, a) = arena.node(id)
-                && let Node::Var(Var::Q(k)) = arena.node(a)
-            {
-                let k = k as usize;
-                let ready = match phase {
-                    Phase::Positions => stage_of[k] < s,
-                    Phase::After => stage_of[k] <= s,
-                    Phase::Final => true,
-                };
-                wanted[k] |= ready;
-            }
-        }
-    }
-    let angles: Vec<usize> = (0..n).filter(|&k| wanted[k]).collect();
-    let nodes: Vec<(Id, Id)> = angles
-        .iter()
-        .map(|&k| {
-            let q = arena.var(Var::Q(var_index(k)));
-            (arena.sin(q), arena.cos(q))
-        })
-        .collect();
-    let filled_by = angles.iter().map(|&k| stage_of[k]).collect();
-    let slot = nodes
-        .iter()
-        .enumerate()
-        .flat_map(|(m, &(sin, cos))| [(sin, 2 * m), (cos, 2 * m + 1)])
-        .collect();
-    TrigCache {
-        angles,
-        nodes,
-        filled_by,
-        slot,
-    }
+    Plan { stages, reads }
 }
 
 /// The earlier stages each stage reads (through its positions or residuals: rates read the
@@ -420,7 +243,6 @@ pub fn single_block(kin: &Kinematics) -> Plan {
             acceleration_rhs: kin.gamma.clone(),
         })],
         reads: vec![Vec::new()],
-        trig: TrigCache::default(),
     }
 }
 
@@ -775,9 +597,10 @@ fn ranks(permutation: &[usize]) -> Vec<usize> {
 
 #[cfg(test)]
 mod tests {
-    use super::{Block, Phase, Stage, stage_coordinates};
+    use super::{Block, Stage, stage_coordinates};
     use crate::expr::tape::{Env, eval};
     use crate::expr::{Arena, Func, Id, Node, Var};
+    use crate::plan::trig::Phase;
 
     fn compile(source: &str) -> crate::Scene {
         crate::compile(crate::Input::Text(source), &crate::Options::default())
@@ -1007,7 +830,7 @@ mod tests {
         assert_eq!(plan.reads, [vec![], vec![], vec![1], vec![1, 2]]);
         // The crank's sine (its stage's rates) and the rod's cosine (the slider's position):
         // slots of two, filled by the angle's stage.
-        let trig = &plan.trig;
+        let trig = &scene.kernels.trig;
         assert_eq!(trig.angles, [5, 8]);
         assert_eq!(trig.filled_by, [1, 2]);
         assert_eq!(
@@ -1026,28 +849,22 @@ mod tests {
     #[test]
     fn a_kernel_reads_the_cache_once_its_angle_is_solved() {
         let scene = compile(&slider_crank(""));
-        let (plan, arena) = (&scene.plan, &scene.model.arena);
+        let (plan, arena, trig) = (&scene.plan, &scene.model.arena, &scene.kernels.trig);
         let sin_rod = trig_of(arena, Func::Sin, 8);
         let b = block(&plan.stages[2]);
         // The block's residual reads sin θ_rod while solving for it: computed, not cached.
         let residual = &b.residuals;
-        assert!(
-            plan.trig
-                .reads(arena, residual, 2, Phase::Positions)
-                .is_empty()
-        );
-        let after = plan.trig.reads(arena, residual, 2, Phase::After);
+        assert!(trig.reads(arena, residual, 2, Phase::Positions).is_empty());
+        let after = trig.reads(arena, residual, 2, Phase::After);
         assert_eq!(after.into_iter().collect::<Vec<_>>(), [(sin_rod, 2)]);
-        let last = plan.trig.reads(arena, residual, 2, Phase::Final);
+        let last = trig.reads(arena, residual, 2, Phase::Final);
         assert_eq!(last.into_iter().collect::<Vec<_>>(), [(sin_rod, 2)]);
         // The slider's x, a stage later, reads the rod's cosine from the cache.
         let Stage::Explicit(slider) = &plan.stages[3] else {
             panic!("the slider's x is explicit")
         };
         let cos_rod = trig_of(arena, Func::Cos, 8);
-        let position = plan
-            .trig
-            .reads(arena, &[slider[0].position], 3, Phase::Positions);
+        let position = trig.reads(arena, &[slider[0].position], 3, Phase::Positions);
         assert_eq!(position.into_iter().collect::<Vec<_>>(), [(cos_rod, 3)]);
     }
 
@@ -1055,14 +872,14 @@ mod tests {
     fn only_what_a_scene_computes_is_cached() {
         // Positions only: no rates read the crank's sine; the slider still reads the rod's cosine.
         let positions = compile(&slider_crank("outputs positions;"));
-        assert_eq!(positions.plan.trig.angles, [8]);
-        assert_eq!(positions.plan.trig.filled_by, [2]);
+        assert_eq!(positions.kernels.trig.angles, [8]);
+        assert_eq!(positions.kernels.trig.filled_by, [2]);
         // A marker on the crank, evaluated after the sweep, reads the crank's angle too.
         let marker = compile(&slider_crank(
             "outputs positions; marker tip: crank @ (40, 0);",
         ));
-        assert_eq!(marker.plan.trig.angles, [5, 8]);
-        assert_eq!(marker.plan.trig.filled_by, [1, 2]);
+        assert_eq!(marker.kernels.trig.angles, [5, 8]);
+        assert_eq!(marker.kernels.trig.filled_by, [1, 2]);
     }
 
     #[test]
@@ -1113,7 +930,7 @@ mod tests {
                 .all(|w| (w[0].1, w[0].0) < (w[1].1, w[1].0))
         );
         assert_eq!(plan.reads, [Vec::<usize>::new()]);
-        assert!(plan.trig.is_empty());
+        assert!(scene.kernels.trig.is_empty());
         assert_eq!(plan.largest_block(), 12);
     }
 }
