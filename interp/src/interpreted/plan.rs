@@ -15,7 +15,8 @@ use super::{Interpreted, Scratch};
 #[derive(Debug, Clone)]
 struct Compiled {
     tape: Tape,
-    outputs: Vec<(Buffer, usize)>,
+    /// Where its values go, grouped by buffer (a block's Jacobian writes two).
+    groups: Vec<Group>,
     /// Whether it reads the trig cache and the multipliers.
     reads_trig: bool,
     reads_lambda: bool,
@@ -25,13 +26,53 @@ impl Compiled {
     fn new(arena: &mechgen::expr::Arena, kernel: &kernels::Kernel) -> Self {
         Compiled {
             tape: Tape::with_inputs(arena, &kernel.roots, &kernel.cached),
-            outputs: kernel.outputs.clone(),
+            groups: Group::of(&kernel.outputs),
             reads_trig: !kernel.cached.is_empty(),
             reads_lambda: kernel
                 .roots
                 .iter()
                 .any(|&root| (arena.variables(root).iter()).any(|v| matches!(v, Var::Lambda(_)))),
         }
+    }
+}
+
+/// A run of a kernel's values that go to one buffer.
+#[derive(Debug, Clone)]
+struct Group {
+    buffer: Buffer,
+    /// The first of its values among the kernel's.
+    start: usize,
+    /// The index in the buffer of each value; `None` when they are `0, 1, 2, …` (a block's
+    /// residuals, its Jacobian values, a right-hand side), copied as one slice.
+    at: Option<Vec<usize>>,
+    len: usize,
+}
+
+impl Group {
+    /// The groups of `outputs`, in order.
+    fn of(outputs: &[(Buffer, usize)]) -> Vec<Group> {
+        let mut groups: Vec<Group> = Vec::new();
+        for (k, &(buffer, _)) in outputs.iter().enumerate() {
+            match groups.last_mut() {
+                Some(g) if g.buffer == buffer => g.len += 1,
+                _ => groups.push(Group {
+                    buffer,
+                    start: k,
+                    at: None,
+                    len: 1,
+                }),
+            }
+        }
+        for g in &mut groups {
+            let at: Vec<usize> = outputs[g.start..g.start + g.len]
+                .iter()
+                .map(|o| o.1)
+                .collect();
+            if at.iter().enumerate().any(|(j, &i)| i != j) {
+                g.at = Some(at);
+            }
+        }
+        groups
     }
 }
 
@@ -470,9 +511,20 @@ impl Interpreted {
     /// `out`, at their indices.
     fn scatter(&self, kernel: &Compiled, buffer: Buffer, out: &mut [f64]) {
         let scratch = self.scratch.borrow();
-        for (&(b, i), &v) in kernel.outputs.iter().zip(&scratch.values) {
-            if let (true, Some(o)) = (b == buffer, out.get_mut(i)) {
-                *o = v;
+        for g in kernel.groups.iter().filter(|g| g.buffer == buffer) {
+            let values = scratch.values.get(g.start..g.start + g.len).unwrap_or(&[]);
+            match &g.at {
+                None => {
+                    let n = values.len().min(out.len());
+                    out[..n].copy_from_slice(&values[..n]);
+                }
+                Some(at) => {
+                    for (&i, &v) in at.iter().zip(values) {
+                        if let Some(o) = out.get_mut(i) {
+                            *o = v;
+                        }
+                    }
+                }
             }
         }
     }
