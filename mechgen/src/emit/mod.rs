@@ -16,6 +16,7 @@ mod plan;
 mod stages;
 
 use std::cell::RefCell;
+use std::collections::HashMap;
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -831,30 +832,8 @@ impl Context<'_> {
             return TokenStream::new();
         }
         let count = idx(kin.branches.len());
-        let mut reads_q = false;
-        let arms: Vec<TokenStream> = kin
-            .branches
-            .iter()
-            .enumerate()
-            .map(|(i, &id)| {
-                let value = if self.arena().is_zero(id) {
-                    quote!(0.0)
-                } else {
-                    let f =
-                        self.function(&[(TokenStream::new(), id)], TokenStream::new(), &computed());
-                    reads_q |= f.args.q == "q";
-                    let body = f.body;
-                    quote! { { #body } }
-                };
-                let i = idx(i);
-                quote! { #i => #value, }
-            })
-            .collect();
-        let q = if reads_q {
-            format_ident!("q")
-        } else {
-            format_ident!("_q")
-        };
+        let computed = computed();
+        let (arms, q, _) = self.branch_arms(kin.branches.iter().map(|&id| (id, &computed)));
         quote! {
             fn branch_count(&self) -> usize {
                 #count
@@ -876,5 +855,41 @@ impl Context<'_> {
                 }
             }
         }
+    }
+}
+
+impl Context<'_> {
+    /// The `match` arms of a method giving each branch invariant's value (`0.0` for one that
+    /// folded to zero), each read with its cached sines and cosines; and the names of its `q`
+    /// and `trig` parameters (with a leading underscore when no arm reads them).
+    pub(super) fn branch_arms<'c>(
+        &self,
+        branches: impl Iterator<Item = (Id, &'c HashMap<Id, usize>)>,
+    ) -> (Vec<TokenStream>, Ident, Ident) {
+        let (mut reads_q, mut reads_trig) = (false, false);
+        let arms = branches
+            .enumerate()
+            .map(|(i, (id, cached))| {
+                let value = if self.arena().is_zero(id) {
+                    quote!(0.0)
+                } else {
+                    let f = self.function(&[(TokenStream::new(), id)], TokenStream::new(), cached);
+                    reads_q |= f.args.q == "q";
+                    reads_trig |= f.args.trig == "trig";
+                    let body = f.body;
+                    quote! { { #body } }
+                };
+                let i = idx(i);
+                quote! { #i => #value, }
+            })
+            .collect();
+        let name = |reads: bool, name: &str| {
+            if reads {
+                format_ident!("{}", name)
+            } else {
+                format_ident!("_{}", name)
+            }
+        };
+        (arms, name(reads_q, "q"), name(reads_trig, "trig"))
     }
 }

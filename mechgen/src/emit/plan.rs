@@ -405,47 +405,15 @@ fn branch_method(cx: &Context<'_>, kernels: &Kernels) -> TokenStream {
     if branches.is_empty() {
         return TokenStream::new();
     }
-    let (mut reads_q, mut reads_trig) = (false, false);
-    let arms: Vec<TokenStream> = branches
-        .iter()
-        .enumerate()
-        .map(|(i, branch)| {
-            let id = branch.roots[0];
-            let value = if cx.arena().is_zero(id) {
-                quote!(0.0)
-            } else {
-                let f = cx.function(
-                    &[(TokenStream::new(), id)],
-                    TokenStream::new(),
-                    &branch.cached,
-                );
-                reads_q |= f.args.q == "q";
-                reads_trig |= f.args.trig == "trig";
-                let body = f.body;
-                quote! { { #body } }
-            };
-            let i = idx(i);
-            quote! { #i => #value, }
-        })
-        .collect();
-    let q = if reads_q {
-        format_ident!("q")
-    } else {
-        format_ident!("_q")
-    };
+    let (arms, q, trig) = cx.branch_arms(branches.iter().map(|b| (b.roots[0], &b.cached)));
     let trig_len = idx(kernels.sizes.trig);
-    let (trig, view) = if reads_trig {
-        (
-            format_ident!("trig"),
-            quote! {
-                let ::core::option::Option::Some(trig) = trig.first_chunk::<#trig_len>() else {
-                    return f64::NAN;
-                };
-            },
-        )
-    } else {
-        (format_ident!("_trig"), TokenStream::new())
-    };
+    let view = (trig == "trig").then(|| {
+        quote! {
+            let ::core::option::Option::Some(trig) = trig.first_chunk::<#trig_len>() else {
+                return f64::NAN;
+            };
+        }
+    });
     quote! {
         /// The invariant's value, signed to be positive on the declared branch.
         fn branch(
