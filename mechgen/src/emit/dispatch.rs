@@ -30,6 +30,7 @@ impl Dispatch {
     /// The kernels take the trig cache (`trig`) and the multipliers (`lambda`) as arrays of
     /// the lengths in `views`: when one reads such a parameter, the method views the
     /// runtime's slice as that array first.
+    // Kept whole: the parameter names, the views and the body are one template's parts.
     pub(super) fn method(
         &self,
         name: &str,

@@ -16,6 +16,7 @@ use crate::plan::reactions::Forces;
 
 impl Context<'_> {
     /// `generalized_forces`, `reactions` and `reaction_name` for `impl Mechanism`.
+    // Kept whole: three sibling methods, each its outputs and one template.
     pub(super) fn force_methods(&self, forces: &Forces) -> TokenStream {
         let vector = self.vector_type();
         let n = idx(self.model.dim());
@@ -119,6 +120,7 @@ impl Context<'_> {
 
     /// `XReactions` (a field per joint and ground body), `XEfforts` (a field per driver) and
     /// the trait `XForces` giving them from a solved state.
+    // Kept whole: one pass over the constraints fills both field lists, then one template.
     pub(super) fn force_accessors(&self) -> TokenStream {
         let model = self.model;
         let (vis, name) = (&model.vis, &model.name);
@@ -202,6 +204,7 @@ impl Context<'_> {
 
     /// The runtime type of a constraint's reaction (its fields are the reaction suffixes) and
     /// the accessor field's doc; `None` for a driver (its effort is a number).
+    // Kept whole: one arm per joint kind, each its runtime type and doc line.
     fn reaction_type(&self, name: &str, kind: &ConstraintKind) -> Option<(&'static str, String)> {
         let by = |a: usize, b: usize| (self.body_name(b), self.body_name(a));
         Some(match *kind {

@@ -9,18 +9,21 @@ use super::body::Context;
 use super::idx;
 use crate::sparse::factor::Factorization;
 
-/// The static LU `k` as straight-line code: the same operations, in the same order, as
-/// [`Factorization::factor`], [`Factorization::solve`] and [`Factorization::solve_transpose`].
-pub(super) fn lu_functions(cx: &Context<'_>, k: usize, f: &Factorization) -> [TokenStream; 3] {
-    let (n, slots) = (idx(f.n), idx(f.slots));
-    let v = |s: usize| {
-        let s = idx(s);
-        quote!(v[#s])
-    };
-    let x = |i: usize| {
-        let i = idx(i);
-        quote!(x[#i])
-    };
+/// `v[s]`: value slot `s`.
+fn v(s: usize) -> TokenStream {
+    let s = idx(s);
+    quote!(v[#s])
+}
+
+/// `x[i]`: entry `i` of the right-hand side, solved in place.
+fn x(i: usize) -> TokenStream {
+    let i = idx(i);
+    quote!(x[#i])
+}
+
+/// [`Factorization::factor`]'s operations: each pivot tested and replaced by its reciprocal,
+/// its multipliers scaled and bounded, the updates of the rest.
+fn factor_statements(f: &Factorization) -> Vec<TokenStream> {
     let mut factor = Vec::new();
     for (step, s) in f.steps.iter().enumerate() {
         let (pivot, k_lit) = (v(s.pivot), idx(step));
@@ -55,6 +58,11 @@ pub(super) fn lu_functions(cx: &Context<'_>, k: usize, f: &Factorization) -> [To
             });
         }
     }
+    factor
+}
+
+/// [`Factorization::solve`]'s operations: forward with L, then back with U.
+fn solve_statements(f: &Factorization) -> Vec<TokenStream> {
     let mut solve = Vec::new();
     for (step_k, s) in f.steps.iter().enumerate() {
         for &(i, l) in &s.lower {
@@ -70,6 +78,11 @@ pub(super) fn lu_functions(cx: &Context<'_>, k: usize, f: &Factorization) -> [To
             solve.push(quote! { #xi -= #u * #xk; });
         }
     }
+    solve
+}
+
+/// [`Factorization::solve_transpose`]'s operations: forward with Uᵀ, then back with Lᵀ.
+fn transpose_statements(f: &Factorization) -> Vec<TokenStream> {
     let mut transpose = Vec::new();
     for (step_k, s) in f.steps.iter().enumerate() {
         let xk = x(step_k);
@@ -87,6 +100,19 @@ pub(super) fn lu_functions(cx: &Context<'_>, k: usize, f: &Factorization) -> [To
             transpose.push(quote! { #xk -= #l * #xi; });
         }
     }
+    transpose
+}
+
+/// The static LU `k` as straight-line code: the same operations, in the same order, as
+/// [`Factorization::factor`], [`Factorization::solve`] and [`Factorization::solve_transpose`].
+// Kept whole: the three functions' signatures and docs, around the statement builders above.
+pub(super) fn lu_functions(cx: &Context<'_>, k: usize, f: &Factorization) -> [TokenStream; 3] {
+    let (n, slots) = (idx(f.n), idx(f.slots));
+    let (factor, solve, transpose) = (
+        factor_statements(f),
+        solve_statements(f),
+        transpose_statements(f),
+    );
     let uses_limit = f.steps.iter().any(|s| !s.lower.is_empty());
     let limit = if uses_limit {
         format_ident!("limit")

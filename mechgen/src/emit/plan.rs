@@ -48,6 +48,7 @@ const ITEMS: [Item; 12] = [
 ];
 
 /// `impl Structured` and the inherent items it dispatches to.
+// Kept whole: half of it is the `impl` template, which reads best in one piece.
 pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan, kernels: &Kernels) -> TokenStream {
     let name = &cx.model.name;
     let table = stage_table(cx.model, plan, &kernels.shapes);
@@ -194,6 +195,7 @@ impl Kernel {
 
 /// The function of kernel `k`: it takes the state its body reads, the trig cache if it reads
 /// it, and time, then the output parameters its method gives it.
+// Kept whole: the kernel's parameters follow from its body, built just before them.
 fn kernel_function(cx: &Context<'_>, kernels: &Kernels, k: &StageKernel) -> (TokenStream, Kernel) {
     let outputs: Vec<(TokenStream, Id)> = k
         .kernel

@@ -22,6 +22,7 @@ impl Differentiator {
     }
 
     /// ∂e/∂var.
+    // Kept whole: one arm per node kind, each its derivative rule.
     pub fn diff(&mut self, arena: &mut Arena, e: Id, var: Var) -> Id {
         if let Some(&d) = self.memo.get(&(e, var)) {
             return d;

@@ -306,6 +306,7 @@ impl Kernels {
 /// In three passes: what each stage computes; the trig cache, planned from those kernels and
 /// the markers (the sine and cosine nodes it needs are added to the arena); then each stage's
 /// trig fill, and what every kernel reads from the cache.
+// Kept whole: its three passes in order, each a few lines over the helpers below.
 pub fn list(
     arena: &mut Arena,
     dim: usize,
