@@ -156,6 +156,28 @@ where
     group.finish();
 }
 
+/// The same steps through `Solver::solve_into` alone, from the previous state: what a step
+/// costs without `Simulation`'s predictor, crossing checks and sub-stepping (so Newton starts
+/// from the last positions rather than from the predicted ones).
+fn solver_steps<M>(c: &mut Criterion, fastest: &Fastest, label: &str, mechanism: M, period: f64)
+where
+    M: Structured + Clone,
+    M::Workspace: Clone,
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let options = Plan::full().reference.options();
+    let checkpoint =
+        Simulation::new(Solver::with_options(mechanism, options), 0.0).expect("scene assembles");
+    let h = period / STEPS as f64;
+    let mut group = c.benchmark_group(label);
+    let start = (checkpoint.solver().clone(), checkpoint.state().clone());
+    time_steps(&mut group, fastest, label, &start, |(solver, state), k| {
+        solver.solve_into(k as f64 * h, state).expect("solves");
+        black_box(state.q[0]);
+    });
+    group.finish();
+}
+
 /// Steps of a revolution of `period` from `checkpoint`.
 fn simulation_steps<M>(
     group: &mut BenchmarkGroup<'_, WallTime>,
@@ -277,6 +299,7 @@ fn seed(c: &mut Criterion, fastest: &Fastest) {
         },
     );
     driven(c, fastest, "seed/generated", seed, period);
+    solver_steps(c, fastest, "seed/generated_solver", seed, period);
     driven(c, fastest, "seed/dense", Dense::new(seed), period);
     driven(
         c,
@@ -364,6 +387,7 @@ fn four_bar(c: &mut Criterion, fastest: &Fastest) {
         },
     );
     driven(c, fastest, "four_bar/generated", four_bar, period);
+    solver_steps(c, fastest, "four_bar/generated_solver", four_bar, period);
     driven(c, fastest, "four_bar/dense", Dense::new(four_bar), period);
     let forward = Dense::new(ForwardDifference::new(four_bar));
     driven(c, fastest, "four_bar/forward_difference", forward, period);
@@ -440,6 +464,15 @@ fn summary(fastest: &Fastest) {
     }
     for scene in ["seed", "four_bar"] {
         let time = |method: &str| fastest.get(&format!("{scene}/{method}"));
+        if let (Some(step), Some(solver)) = (time("generated"), time("generated_solver")) {
+            println!(
+                "  {scene}: Simulation step {:.1} ns; Solver::solve_into from the last positions \
+                 {:.1} ns ({:+.1} ns: what the predictor saves, less the bookkeeping)",
+                step * 1e9,
+                solver * 1e9,
+                (step - solver) * 1e9
+            );
+        }
         if let (Some(hand), Some(generated)) = (time("written_out"), time("generated")) {
             println!(
                 "  {scene}: written out by hand {:.1} ns per step; generated {:.2}× that",
