@@ -17,6 +17,8 @@ struct Compiled {
     tape: Tape,
     /// Where its values go, grouped by buffer (a block's Jacobian writes two).
     groups: Vec<Group>,
+    /// The length each buffer it writes must have (`Kernels::buffer_len`, looked up once).
+    lengths: Vec<(Buffer, usize)>,
     /// Whether it reads the trig cache and the multipliers.
     reads_trig: bool,
     reads_lambda: bool,
@@ -27,6 +29,7 @@ impl Compiled {
         Compiled {
             tape: Tape::with_inputs(arena, &kernel.roots, &kernel.cached),
             groups: Group::of(&kernel.outputs),
+            lengths: Vec::new(),
             reads_trig: !kernel.cached.is_empty(),
             reads_lambda: kernel
                 .roots
@@ -103,7 +106,17 @@ impl PlanTapes {
             dispatch[kernel.stage][kernel.method as usize] = Some(k);
         }
         let compile = |kernel: &kernels::Kernel| Compiled::new(arena, kernel);
-        let kernels: Vec<Compiled> = list.stages.iter().map(|k| compile(&k.kernel)).collect();
+        let kernels: Vec<Compiled> = list
+            .stages
+            .iter()
+            .map(|k| {
+                let mut compiled = compile(&k.kernel);
+                compiled.lengths = (compiled.groups.iter())
+                    .map(|g| (g.buffer, list.buffer_len(k.stage, g.buffer)))
+                    .collect();
+                compiled
+            })
+            .collect();
         let of = |m: Method| {
             let stages = list.stages.iter().zip(&kernels);
             stages.filter(move |(k, _)| k.method == m).map(|(_, c)| c)
@@ -155,8 +168,11 @@ impl PlanTapes {
         let Some(kernel) = self.kernel(stage, method) else {
             return Found::Elsewhere;
         };
-        let fits = |&(buffer, len): &(Buffer, usize)| len >= self.list.buffer_len(stage, buffer);
-        if outputs.iter().all(fits) {
+        let needs = |buffer: Buffer| {
+            let length = kernel.lengths.iter().find(|l| l.0 == buffer);
+            length.map_or(0, |l| l.1)
+        };
+        if outputs.iter().all(|&(buffer, len)| len >= needs(buffer)) {
             Found::Kernel(kernel)
         } else {
             Found::Short
