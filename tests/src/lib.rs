@@ -14,6 +14,19 @@ macro_rules! twin {
     };
 }
 
+/// The interpreter running an example scene's `.mech` file (`examples/scenes/FILE`), compiled
+/// with the default options; the twin of the generated scene of the same name.
+///
+/// # Panics
+/// If the file cannot be read or does not compile (a test's fixture, not user input).
+pub fn example_scene(file: &str) -> mechgen_interp::Interpreted {
+    let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
+    let source = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let scene = mechgen::compile(mechgen::Input::Text(&source), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{path}: {e}"));
+    mechgen_interp::Interpreted::new(&scene)
+}
+
 #[doc = include_str!("../../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;

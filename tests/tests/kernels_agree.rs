@@ -6,9 +6,9 @@
 //! contract itself, for any caller.
 
 use mechgen_examples::scenes::{FourBar, PistonCrankDynamics};
-use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{Storage, Structured, Vector};
+use mechgen_tests::example_scene;
 
 /// What an untouched entry holds.
 const SENTINEL: f64 = 7.25e101;
@@ -87,14 +87,6 @@ fn agree(generated: &[(String, Vec<f64>)], interpreted: &[(String, Vec<f64>)]) {
     }
 }
 
-fn twin(file: &str) -> Interpreted {
-    let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(&path).expect("scene file");
-    let scene = mechgen::compile(mechgen::Input::Text(&text), &mechgen::Options::default())
-        .unwrap_or_else(|e| panic!("{path}: {e}"));
-    Interpreted::new(&scene)
-}
-
 /// A state of no particular meaning: kernels are functions of it, consistent or not.
 fn state(n: usize, phase: f64) -> [Vec<f64>; 3] {
     let wave = |k: f64| {
@@ -111,12 +103,12 @@ fn every_method_of_every_stage_writes_what_generated_code_writes() {
         let [q, qd, qdd] = state(15, phase);
         agree(
             &transcript(&PistonCrankDynamics::default(), &q, &qd, &qdd),
-            &transcript(&twin("piston_crank_dynamics.mech"), &q, &qd, &qdd),
+            &transcript(&example_scene("piston_crank_dynamics.mech"), &q, &qd, &qdd),
         );
         let [q, qd, qdd] = state(12, phase);
         agree(
             &transcript(&FourBar::default(), &q, &qd, &qdd),
-            &transcript(&twin("four_bar.mech"), &q, &qd, &qdd),
+            &transcript(&example_scene("four_bar.mech"), &q, &qd, &qdd),
         );
     }
 }

@@ -7,6 +7,7 @@ use mechgen_examples::scenes::{FourBar, PistonCrank};
 use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::{DMatrix, DVector, Dyn};
 use mechgen_runtime::{Accelerations, Matrix, Mechanism, Vector};
+use mechgen_tests::example_scene as interpreted;
 use mechgen_tests::twin;
 use proptest::prelude::*;
 
@@ -37,14 +38,6 @@ twin! {
         driver sweep: slide(slider, pointer @ (1, 0), along (1, 0.2))
             = atan2(t, 1) + abs(t - 0.5) + min(t, 0.3) + max(t, 0.7) + asin(t) + acos(t) + pi / 10;
     }
-}
-
-fn interpreted(file: &str) -> Interpreted {
-    let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
-    let source = std::fs::read_to_string(&path).expect("scene file");
-    let scene = mechgen::compile(mechgen::Input::Text(&source), &mechgen::Options::default())
-        .unwrap_or_else(|e| panic!("{path}: {e}"));
-    Interpreted::new(&scene)
 }
 
 /// Random states: positions within a few hundred mm, any angle, fast velocities, any time.

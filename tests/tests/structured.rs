@@ -6,12 +6,12 @@
 use mechgen_examples::closed_form;
 use mechgen_examples::scenes::{FourBar, OffsetSlider, PistonCrank};
 use mechgen_examples::stability::{FlexiblePistonCrank, SliderCrank};
-use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::{Const, DefaultAllocator};
 use mechgen_runtime::{
     Accelerations, Dense, Mechanism, Simulation, SolveError, Solver, SolverOptions, State, Storage,
     Structured, Vector, mechanism,
 };
+use mechgen_tests::example_scene as interpreted;
 use num_dual::{DualNum, second_derivative};
 use proptest::prelude::*;
 
@@ -282,14 +282,6 @@ fn a_singular_block_names_the_coordinates_downstream() {
     };
     let undetermined = names(solver.undetermined_coordinates());
     assert_eq!(undetermined, ["rod.theta", "slider.x"]);
-}
-
-fn interpreted(file: &str) -> Interpreted {
-    let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
-    let source = std::fs::read_to_string(&path).expect("scene file");
-    let scene = mechgen::compile(mechgen::Input::Text(&source), &mechgen::Options::default())
-        .unwrap_or_else(|e| panic!("{path}: {e}"));
-    Interpreted::new(&scene)
 }
 
 /// One solve from `guess` at `t`, as (q, q̇, q̈).

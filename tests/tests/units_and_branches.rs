@@ -7,15 +7,7 @@ use mechgen_examples::scenes::{FourBar, OffsetSlider, PistonCrank};
 use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::{Const, DVector};
 use mechgen_runtime::{Mechanism, Simulation, Solver, Structured, Unit, Vector};
-
-fn interpreted(file: &str) -> Interpreted {
-    let path = format!("{}/../examples/scenes/{file}", env!("CARGO_MANIFEST_DIR"));
-    let source = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    Interpreted::new(
-        &mechgen::compile(mechgen::Input::Text(&source), &mechgen::Options::default())
-            .unwrap_or_else(|e| panic!("{e}")),
-    )
-}
+use mechgen_tests::example_scene as interpreted;
 
 /// Units, length scale and branch names agree, past the ends too.
 fn assert_same_metadata<M: Mechanism<Dim = Const<N>>, const N: usize>(

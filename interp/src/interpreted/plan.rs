@@ -25,11 +25,20 @@ struct Compiled {
 }
 
 impl Compiled {
-    fn new(arena: &mechgen::expr::Arena, kernel: &kernels::Kernel) -> Self {
+    /// `kernel` as a tape; `length` gives the length each buffer it writes must have.
+    fn new(
+        arena: &mechgen::expr::Arena,
+        kernel: &kernels::Kernel,
+        length: impl Fn(Buffer) -> usize,
+    ) -> Self {
+        let groups = Group::of(&kernel.outputs);
         Compiled {
             tape: Tape::with_inputs(arena, &kernel.roots, &kernel.cached),
-            groups: Group::of(&kernel.outputs),
-            lengths: Vec::new(),
+            lengths: groups
+                .iter()
+                .map(|g| (g.buffer, length(g.buffer)))
+                .collect(),
+            groups,
             reads_trig: !kernel.cached.is_empty(),
             reads_lambda: kernel
                 .roots
@@ -105,17 +114,10 @@ impl PlanTapes {
         for (k, kernel) in list.stages.iter().enumerate() {
             dispatch[kernel.stage][kernel.method as usize] = Some(k);
         }
-        let compile = |kernel: &kernels::Kernel| Compiled::new(arena, kernel);
-        let kernels: Vec<Compiled> = list
-            .stages
-            .iter()
-            .map(|k| {
-                let mut compiled = compile(&k.kernel);
-                compiled.lengths = (compiled.groups.iter())
-                    .map(|g| (g.buffer, list.buffer_len(k.stage, g.buffer)))
-                    .collect();
-                compiled
-            })
+        // The markers and branches are read through their own methods, which check nothing.
+        let compile = |kernel: &kernels::Kernel| Compiled::new(arena, kernel, |_| 0);
+        let kernels: Vec<Compiled> = (list.stages.iter())
+            .map(|k| Compiled::new(arena, &k.kernel, |b| list.buffer_len(k.stage, b)))
             .collect();
         let of = |m: Method| {
             let stages = list.stages.iter().zip(&kernels);
@@ -243,13 +245,8 @@ impl Structured for Interpreted {
     }
 
     fn assign_positions(&self, stage: usize, q: &mut Vector<Dyn>, trig: &[f64], t: f64) {
-        let found = self.plan.find(
-            stage,
-            Method::Positions,
-            [trig.len(), 0],
-            &[(Buffer::Q, q.len())],
-        );
-        if let Some(kernel) = self.ready(found, q.as_mut_slice()) {
+        let assigning = self.assigning(stage, Method::Positions, trig.len(), q.as_mut_slice());
+        if let Some(kernel) = assigning {
             self.evaluate(kernel, self.inputs_with(q.as_slice(), &[], &[], trig, t));
             self.scatter(kernel, Method::Positions.target(), q.as_mut_slice());
         }
@@ -263,11 +260,8 @@ impl Structured for Interpreted {
         qd: &mut Vector<Dyn>,
         t: f64,
     ) {
-        let outputs = [(Buffer::Qd, qd.len())];
-        let found = self
-            .plan
-            .find(stage, Method::Velocities, [trig.len(), 0], &outputs);
-        if let Some(kernel) = self.ready(found, qd.as_mut_slice()) {
+        let assigning = self.assigning(stage, Method::Velocities, trig.len(), qd.as_mut_slice());
+        if let Some(kernel) = assigning {
             self.evaluate(
                 kernel,
                 self.inputs_with(q.as_slice(), qd.as_slice(), &[], trig, t),
@@ -285,11 +279,9 @@ impl Structured for Interpreted {
         qdd: &mut Vector<Dyn>,
         t: f64,
     ) {
-        let outputs = [(Buffer::Qdd, qdd.len())];
-        let found = self
-            .plan
-            .find(stage, Method::Accelerations, [trig.len(), 0], &outputs);
-        if let Some(kernel) = self.ready(found, qdd.as_mut_slice()) {
+        let assigning =
+            self.assigning(stage, Method::Accelerations, trig.len(), qdd.as_mut_slice());
+        if let Some(kernel) = assigning {
             self.evaluate(
                 kernel,
                 self.inputs_with(q.as_slice(), qd.as_slice(), qdd.as_slice(), trig, t),
@@ -327,11 +319,8 @@ impl Structured for Interpreted {
     }
 
     fn fill_trig(&self, stage: usize, q: &Vector<Dyn>, trig: &mut [f64]) {
-        let outputs = [(Buffer::Trig, trig.len())];
-        let found = self
-            .plan
-            .find(stage, Method::FillTrig, [trig.len(), 0], &outputs);
-        if let Some(kernel) = self.ready(found, trig) {
+        let assigning = self.assigning(stage, Method::FillTrig, trig.len(), trig);
+        if let Some(kernel) = assigning {
             self.evaluate(kernel, self.inputs(q.as_slice(), &[], 0.0));
             self.scatter(kernel, Method::FillTrig.target(), trig);
         }
@@ -489,10 +478,18 @@ impl Structured for Interpreted {
 }
 
 impl Interpreted {
-    /// The kernel an assignment (of positions, rates or cache slots) runs; NaN in `out` where
-    /// the buffers do not fit; nothing without a kernel (the trait's default writes nothing).
-    fn ready<'a>(&self, found: Found<'a>, out: &mut [f64]) -> Option<&'a Compiled> {
-        match found {
+    /// The kernel an assignment of `method` (positions, rates or cache slots, into `out`, with a
+    /// trig cache of `trig` slots) runs for `stage`; NaN in `out` where the buffers do not fit;
+    /// nothing without a kernel (the trait's default writes nothing).
+    fn assigning(
+        &self,
+        stage: usize,
+        method: Method,
+        trig: usize,
+        out: &mut [f64],
+    ) -> Option<&Compiled> {
+        let outputs = [(method.target(), out.len())];
+        match self.plan.find(stage, method, [trig, 0], &outputs) {
             Found::Kernel(kernel) => Some(kernel),
             Found::Short => {
                 out.fill(f64::NAN);
