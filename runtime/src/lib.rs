@@ -68,6 +68,7 @@ mod block_signs;
 pub mod codegen;
 mod crossing;
 mod dense;
+mod dynamic;
 mod error;
 mod finite;
 mod forces;
@@ -89,6 +90,7 @@ mod workspace;
 
 pub use assembly::{AssemblyError, GUESS_TIME, MAX_CONTINUATION_STEPS};
 pub use dense::Dense;
+pub use dynamic::{Dynamic, EnergyTerms, FreeStorage};
 pub use error::{Described, Quantity, SolveError};
 pub use geometry::{GeometryFault, MAX_LENGTH, Requirement};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
