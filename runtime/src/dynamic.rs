@@ -12,6 +12,8 @@
 use nalgebra::allocator::Allocator;
 use nalgebra::{DefaultAllocator, Dim};
 
+#[cfg(doc)]
+use crate::mechanism::Mechanism;
 use crate::mechanism::{Forces, Storage, Vector};
 
 /// Storage bounds for a scene with `D` coordinates and `F` free degrees of freedom; repeat
@@ -19,8 +21,8 @@ use crate::mechanism::{Forces, Storage, Vector};
 pub trait FreeStorage<D: Dim, F: Dim>: Allocator<F> + Allocator<F, F> + Allocator<D, F> {}
 impl<D: Dim, F: Dim, A: Allocator<F> + Allocator<F, F> + Allocator<D, F>> FreeStorage<D, F> for A {}
 
-/// The conservative energies and the powers at one state, from [`Dynamic::energy_terms`]
-/// (the kinetic energy is `½ q̇ᵀ M q̇`, from [`Dynamic::mass_times`]).
+/// The conservative energies and the powers at one state, from [`EquationsOfMotion::energy_terms`]
+/// (the kinetic energy is `½ q̇ᵀ M q̇`, from [`EquationsOfMotion::mass_times`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct EnergyTerms {
     /// Potential energy of gravity, `−Σ m g · c` over the bodies' centres of mass `c`.
@@ -33,39 +35,18 @@ pub struct EnergyTerms {
     pub dampers: f64,
 }
 
-/// A scene with free degrees of freedom that moves under its forces.
+/// The equations of motion `M(q) q̈ = Q(q, q̇, t) + Φ_qᵀ λ` of a scene with masses, as the
+/// integrator uses them: products with `M` and with the derivatives of `Q`, only their
+/// non-zeros computed, and the energies ([`Mechanism::generalized_forces`] gives
+/// `F = Q − M q̈`).
 ///
-/// Generated for a scene that declares `free` degrees of freedom (and masses); the interpreter
-/// implements it too. Implementations are straight-line code: they must not allocate or panic.
-pub trait Dynamic: Forces
+/// Generated with [`Dynamic`], for a scene that declares free degrees of freedom; the
+/// interpreter implements it too. Implementations are straight-line code: they must not
+/// allocate or panic.
+pub trait EquationsOfMotion: Forces
 where
-    DefaultAllocator: Storage<Self::Dim> + FreeStorage<Self::Dim, Self::Free>,
+    DefaultAllocator: Storage<Self::Dim>,
 {
-    /// Type-level number of free degrees of freedom.
-    type Free: Dim;
-
-    /// The number of free degrees of freedom, as a value of the type-level dimension.
-    fn free(&self) -> Self::Free;
-
-    /// Name of free degree of freedom `k` (its declaration's name); `None` past the end.
-    fn free_name(&self, k: usize) -> Option<&str>;
-
-    /// The equation that holds free degree of freedom `k` at its state (the row its
-    /// declaration adds); `usize::MAX` past the end.
-    fn free_equation(&self, k: usize) -> usize;
-
-    /// The declared initial value of free degree of freedom `k` (`None`: the value at the
-    /// scene's initial guess, assembled) and its declared initial rate (0 unless declared).
-    fn free_initial(&self, k: usize) -> (Option<f64>, f64);
-
-    /// The `[value, rate, acceleration]` the kinematic solve holds free degree of freedom `k`
-    /// at; NaNs past the end.
-    fn free_state(&self, k: usize) -> [f64; 3];
-
-    /// Sets the `[value, rate, acceleration]` of free degree of freedom `k` (ignored past the
-    /// end).
-    fn set_free(&mut self, k: usize, state: [f64; 3]);
-
     /// Writes `M(q) v`.
     fn mass_times(&self, q: &Vector<Self::Dim>, v: &Vector<Self::Dim>, out: &mut Vector<Self::Dim>);
 
@@ -97,4 +78,38 @@ where
 
     /// The potential energies and powers at `(q, q̇, t)`.
     fn energy_terms(&self, q: &Vector<Self::Dim>, qd: &Vector<Self::Dim>, t: f64) -> EnergyTerms;
+}
+
+/// A scene with free degrees of freedom that moves under its forces.
+///
+/// Generated for a scene that declares `free` degrees of freedom (and masses); the interpreter
+/// implements it too. Implementations are straight-line code: they must not allocate or panic.
+pub trait Dynamic: EquationsOfMotion
+where
+    DefaultAllocator: Storage<Self::Dim> + FreeStorage<Self::Dim, Self::Free>,
+{
+    /// Type-level number of free degrees of freedom.
+    type Free: Dim;
+
+    /// The number of free degrees of freedom, as a value of the type-level dimension.
+    fn free(&self) -> Self::Free;
+
+    /// Name of free degree of freedom `k` (its declaration's name); `None` past the end.
+    fn free_name(&self, k: usize) -> Option<&str>;
+
+    /// The equation that holds free degree of freedom `k` at its state (the row its
+    /// declaration adds); `usize::MAX` past the end.
+    fn free_equation(&self, k: usize) -> usize;
+
+    /// The declared initial value of free degree of freedom `k` (`None`: the value at the
+    /// scene's initial guess, assembled) and its declared initial rate (0 unless declared).
+    fn free_initial(&self, k: usize) -> (Option<f64>, f64);
+
+    /// The `[value, rate, acceleration]` the kinematic solve holds free degree of freedom `k`
+    /// at; NaNs past the end.
+    fn free_state(&self, k: usize) -> [f64; 3];
+
+    /// Sets the `[value, rate, acceleration]` of free degree of freedom `k` (ignored past the
+    /// end).
+    fn set_free(&mut self, k: usize, state: [f64; 3]);
 }

@@ -90,7 +90,7 @@ mod workspace;
 
 pub use assembly::{AssemblyError, GUESS_TIME, MAX_CONTINUATION_STEPS};
 pub use dense::Dense;
-pub use dynamic::{Dynamic, EnergyTerms, FreeStorage};
+pub use dynamic::{Dynamic, EnergyTerms, EquationsOfMotion, FreeStorage};
 pub use error::{Described, Quantity, SolveError};
 pub use geometry::{GeometryFault, MAX_LENGTH, Requirement};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
