@@ -40,8 +40,8 @@ pub struct EnergyTerms {
 /// non-zeros computed, and the energies ([`Mechanism::generalized_forces`] gives
 /// `F = Q − M q̈`).
 ///
-/// Generated with [`Dynamic`], for a scene that declares free degrees of freedom; the
-/// interpreter implements it too. Implementations are straight-line code: they must not
+/// Generated with [`Dynamic`] (the integrator needs both), for a scene that declares free
+/// degrees of freedom; the interpreter implements it too. Implementations are straight-line code: they must not
 /// allocate or panic.
 pub trait EquationsOfMotion: Forces
 where
@@ -84,7 +84,7 @@ where
 ///
 /// Generated for a scene that declares `free` degrees of freedom (and masses); the interpreter
 /// implements it too. Implementations are straight-line code: they must not allocate or panic.
-pub trait Dynamic: EquationsOfMotion
+pub trait Dynamic: Forces
 where
     DefaultAllocator: Storage<Self::Dim> + FreeStorage<Self::Dim, Self::Free>,
 {
