@@ -147,6 +147,47 @@ pub fn load_witnesses(model: &mut Model) -> Vec<Id> {
     witnesses
 }
 
+/// A force load's value in world axes (turned by its body's angle when given in the body's
+/// axes) and the world point it acts at.
+pub(super) fn world_force(
+    frames: &mut Frames<'_>,
+    point: Point,
+    value: [Id; 2],
+    local: bool,
+) -> ([Id; 2], [Id; 2]) {
+    let value = if local {
+        frames.rotate(point.body, value)
+    } else {
+        value
+    };
+    (value, frames.world_point(point))
+}
+
+/// A spring-damper's line: `d = P_b − P_a` (world axes), `d · d = ℓ²` and `d · ḋ = ℓ ℓ̇`.
+pub(super) struct SpringGeometry {
+    pub d: [Id; 2],
+    pub squared: Id,
+    pub approach: Id,
+}
+
+/// The line of a spring-damper between the points `a` and `b`, its rate along the motion.
+pub(super) fn spring_geometry(
+    frames: &mut Frames<'_>,
+    diff: &mut Differentiator,
+    a: Point,
+    b: Point,
+) -> SpringGeometry {
+    let d = frames.separation(a, b);
+    let squared = frames.dot(d, d);
+    let rate = d.map(|x| diff.time_derivative(frames.arena, x));
+    let approach = frames.dot(d, rate);
+    SpringGeometry {
+        d,
+        squared,
+        approach,
+    }
+}
+
 /// The forces gathered so far, and what builds them.
 struct Work<'a> {
     frames: Frames<'a>,
@@ -167,12 +208,7 @@ impl Work<'_> {
                 value,
                 local,
             } => {
-                let value = if local {
-                    self.frames.rotate(point.body, value)
-                } else {
-                    value
-                };
-                let at = self.frames.world_point(point);
+                let (value, at) = world_force(&mut self.frames, point, value, local);
                 self.apply(value, at);
             }
             LoadKind::Torque { body, value } => self.torque(body, value),
@@ -250,10 +286,11 @@ impl Work<'_> {
     /// direction, and the force, are undefined there.
     fn spring(&mut self, a: Point, b: Point, [stiffness, length, damping]: [Id; 3]) {
         let (at_a, at_b) = (self.frames.world_point(a), self.frames.world_point(b));
-        let d = self.frames.separation(a, b);
-        let squared = self.frames.dot(d, d);
-        let rate = d.map(|x| self.d.time_derivative(self.frames.arena, x));
-        let approach = self.frames.dot(d, rate);
+        let SpringGeometry {
+            d,
+            squared,
+            approach,
+        } = spring_geometry(&mut self.frames, &mut self.d, a, b);
         let arena = &mut *self.frames.arena;
         let distance = arena.call(Func::Sqrt, squared);
         let rest = arena.mul(stiffness, length);

@@ -5,10 +5,12 @@
 //!
 //! What is derived from it: body frames as every stage writes through them (`frames`), the
 //! constraint equations and their derivatives ([`kinematics`]), marker values ([`markers`]),
-//! the generalised forces ([`dynamics`]), and the run-time rules on geometry and mass
-//! properties written in parameters ([`geometry`], [`physics`]).
+//! the generalised forces ([`dynamics`]), the equations of motion and the energies
+//! ([`motion`], [`energy`]), and the run-time rules on geometry and mass properties written in
+//! parameters ([`geometry`], [`physics`]).
 
 pub mod dynamics;
+pub mod energy;
 mod frames;
 pub mod geometry;
 pub mod kinematics;
