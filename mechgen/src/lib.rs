@@ -7,6 +7,7 @@
 //! ```text
 //! tokens / .mech ─syntax─▶ Spec ─check─▶ Model ─model::kinematics─▶ Φ, Φ_q, ν, γ ─plan::structure─▶ Plan
 //!   (scenes that compute forces) ─model::dynamics─▶ F ─plan::reactions─▶ reverse stages, reactions
+//!   (scenes that need them) F ─model::{motion, energy}─▶ M, Q, K, C, energies ─plan::motion─▶ M v, K v, C v
 //!   Scene (model, kinematics, plan, forces) ─plan::kernels─▶ kernel list ─emit─▶ Rust tokens
 //!                                                                       └─(mechgen-interp)─▶ numbers
 //! ```
@@ -48,7 +49,7 @@ pub use plan::Scene;
 pub use syntax::limits::Limits;
 
 use model::{dynamics, kinematics};
-use plan::{kernels, reactions, structure};
+use plan::{kernels, motion, reactions, structure};
 use syntax::spec::Spec;
 
 /// What [`compile`] and [`expand`] read.
@@ -100,18 +101,25 @@ pub fn compile(input: Input<'_>, options: &Options) -> Result<Scene, Errors> {
         expr::Arena::new()
     };
     let model = check::check_into(spec, arena)?;
-    Ok(scene(model))
+    Ok(scene(model, &options.codegen))
 }
 
-/// The stages after `check`: kinematics, the solve structure, and for a scene that computes
-/// forces its dynamics and the force solve's structure.
-fn scene(mut model: Model) -> Scene {
+/// The stages after `check`: kinematics, the solve structure, for a scene that computes
+/// forces its dynamics and the force solve's structure, and for one that needs them its
+/// equations of motion.
+fn scene(mut model: Model, codegen: &CodegenOptions) -> Scene {
     let kinematics = kinematics::derive(&mut model);
     let plan = structure::plan(&mut model, &kinematics);
     let forces = (model.outputs >= model::Outputs::Forces).then(|| {
         let generalized = dynamics::derive(&mut model);
         reactions::plan(&mut model, &kinematics, &plan, generalized)
     });
+    let motion = match &forces {
+        Some(forces) if motion::needs_motion(&model, codegen.equations_of_motion) => {
+            Some(motion::plan(&mut model, &forces.generalized))
+        }
+        _ => None,
+    };
     let dim = model.dim();
     let kernels = kernels::list(
         &mut model.arena,
@@ -130,6 +138,7 @@ fn scene(mut model: Model) -> Scene {
         kinematics,
         plan,
         forces,
+        motion,
         kernels,
         load_witnesses,
     }

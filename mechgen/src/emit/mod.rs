@@ -1,6 +1,7 @@
 //! Emission: a scene as Rust items (`quote!`): the parameter struct and its constants, the
 //! textbook functions (`impl Mechanism`: Φ, Φ_q, ν, γ over all coordinates), the solve structure
-//! (`impl Structured`, in `plan`) and the named body accessors.
+//! (`impl Structured`, in `plan`), the named body accessors, and the equations of motion of a
+//! scene that carries them (`impl EquationsOfMotion`, in `motion`).
 //!
 //! Bodies are straight-line code (`body`): no loops, no allocation, no `std`, no `unsafe`;
 //! elementary functions come from `::mechgen_runtime::codegen::math`. Zero entries are never computed:
@@ -12,6 +13,7 @@ mod dispatch;
 mod forces;
 mod lu;
 mod markers;
+mod motion;
 mod plan;
 mod stages;
 
@@ -42,6 +44,11 @@ pub struct CodegenOptions {
     /// sub-expressions (every use evaluated again) and no solve structure (one block, factored
     /// with partial pivoting). Never for production code.
     pub naive: bool,
+    /// Emit the equations of motion (`mechgen_runtime::EquationsOfMotion`: the products with
+    /// the mass matrix and the tangent stiffness and damping, and the energies) for a scene
+    /// that computes forces: for linearising a prescribed motion or driving an integrator of
+    /// one's own. Off by default: the code is exactly what it was without it.
+    pub equations_of_motion: bool,
 }
 
 impl Default for CodegenOptions {
@@ -49,6 +56,7 @@ impl Default for CodegenOptions {
         Self {
             max_function_size: 2_000,
             naive: false,
+            equations_of_motion: false,
         }
     }
 }
@@ -77,6 +85,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
     let structured = plan::structured_impl(&cx, &scene.plan, &scene.kernels);
     let accessors = cx.accessors();
     let force_accessors = cx.forces.map(|_| cx.force_accessors());
+    let motion = scene.motion.as_ref().map(|eom| cx.motion_impl(eom));
     // Split bodies' parts, collected while the functions above were generated.
     let helpers = cx.helpers.into_inner();
     let name = &scene.model.name;
@@ -97,6 +106,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
         #helpers
         #accessors
         #force_accessors
+        #motion
     }
 }
 

@@ -1,9 +1,10 @@
 //! Planning the solve, once per scene at generation time: the stages that decide the
 //! coordinates ([`structure`]), the force solve that runs them in reverse ([`reactions`]), the
-//! planned [`Scene`] that the emitter and the interpreter read, and its operation counts
-//! ([`stats`]).
+//! planned [`Scene`] that the emitter and the interpreter read, its equations of motion
+//! ([`motion`]), and its operation counts ([`stats`]).
 
 pub mod kernels;
+pub mod motion;
 pub mod reactions;
 pub mod scene;
 pub mod stats;

@@ -1,7 +1,7 @@
 //! The planned scene: the checked model with everything derived from it, which the emitter
 //! renders and the interpreter runs.
 
-use super::{kernels, reactions, structure};
+use super::{kernels, motion, reactions, structure};
 use crate::expr;
 use crate::model::Model;
 use crate::model::kinematics::Kinematics;
@@ -19,6 +19,9 @@ pub struct Scene {
     /// The force solve, for a scene that computes forces: the generalised forces, the plan's
     /// stages in reverse, the reported reactions.
     pub forces: Option<reactions::Forces>,
+    /// The equations of motion and energies, for a scene that needs them
+    /// ([`motion::needs_motion`]).
+    pub motion: Option<motion::EquationsOfMotion>,
     /// Every kernel of the plan and the force solve, as the emitter and the interpreter run them.
     pub kernels: kernels::Kernels,
     /// For a scene that computes forces, two values per load that name the load making F
