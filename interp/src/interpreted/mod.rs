@@ -1,5 +1,6 @@
 //! A compiled scene evaluated by the interpreter, behind the runtime's `Mechanism` (the
-//! textbook functions, `textbook`) and `Structured` (the plan's kernels, `plan`) traits.
+//! textbook functions, `textbook`), `Structured` (the plan's kernels, `plan`) and
+//! `EquationsOfMotion` (`motion`) traits.
 //!
 //! This is what a run-time (non-generated) library would do: the same IR and the same kernel
 //! list as the generated code, walked at run time (tapes for the expressions, the static LU's
@@ -7,6 +8,7 @@
 //! one solver implementation of `mechgen-runtime` with scenes read from `.mech` files, and it
 //! agrees with generated code to the bit.
 
+mod motion;
 mod plan;
 mod textbook;
 
@@ -20,6 +22,7 @@ use mechgen::model::physics;
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{Matrix, Names, Outputs, Unit};
 
+use motion::MotionTapes;
 use plan::PlanTapes;
 use textbook::{Textbook, unit};
 
@@ -52,6 +55,8 @@ pub struct Interpreted {
     textbook: Textbook,
     /// The plan's kernels as tapes.
     plan: PlanTapes,
+    /// The equations of motion, for a scene compiled with them.
+    motion: Option<MotionTapes>,
     /// Tape slots and output values, reused by every call (evaluation is `&self`).
     scratch: RefCell<Scratch>,
     /// Block Jacobian evaluations so far: the unit of a solve's work, which fuzzing bounds.
@@ -76,8 +81,11 @@ impl Interpreted {
         let (model, kin) = (&scene.model, &scene.kinematics);
         let textbook = Textbook::new(scene);
         let plan = PlanTapes::new(&model.arena, &scene.kernels);
+        let motion = (scene.motion.as_ref()).map(|m| MotionTapes::new(&model.arena, m));
         // One scratch serves every tape: the most instructions and the most outputs of any.
-        let tapes = || textbook.tapes().chain(plan.tapes());
+        let tapes = || {
+            (textbook.tapes().chain(plan.tapes())).chain(motion.iter().flat_map(MotionTapes::tapes))
+        };
         let slots = tapes().map(Tape::len).max().unwrap_or(0);
         let values = tapes().map(Tape::output_count).max().unwrap_or(0).max(1);
         let outputs = match model.outputs {
@@ -116,6 +124,7 @@ impl Interpreted {
             physics: kin.physics.clone(),
             textbook,
             plan,
+            motion,
             evaluations: Cell::new(0),
             scratch: RefCell::new(Scratch {
                 slots: vec![0.0; slots],

@@ -92,7 +92,7 @@ pub(super) fn unit(unit: mechgen::model::Unit) -> Unit {
     }
 }
 
-fn copy_into(values: &[f64], out: &mut Vector<Dyn>) {
+pub(super) fn copy_into(values: &[f64], out: &mut Vector<Dyn>) {
     for (o, v) in out.iter_mut().zip(values) {
         *o = *v;
     }
