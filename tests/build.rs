@@ -1,7 +1,7 @@
 //! Generates into `OUT_DIR` what the tests include with options the `mechanism!` macro does not
 //! take (the `build.rs` route users take for them): the seed with a tiny `max_function_size`,
 //! so that a test can hold split generated functions to the unsplit ones, and the motion
-//! kernels' scene with its equations of motion (`tests/motion_kernels.rs`).
+//! kernels' scene with its equations of motion, whole and split (`tests/motion_kernels.rs`).
 
 use std::path::{Path, PathBuf};
 
@@ -20,11 +20,13 @@ fn main() {
         equations_of_motion: true,
         ..Default::default()
     };
-    generate(
-        &root.join("data/swing_motion.mech"),
-        motion,
-        "swing_motion.rs",
-    );
+    let scene = root.join("data/swing_motion.mech");
+    generate(&scene, motion, "swing_motion.rs");
+    let motion_split = mechgen::CodegenOptions {
+        max_function_size: 12,
+        ..motion
+    };
+    generate(&scene, motion_split, "swing_motion_split.rs");
 }
 
 /// Writes the code of the scene at `path`, generated with `codegen`, to `OUT_DIR/file`.

@@ -5,7 +5,7 @@
 //! Held to independent references: `M v` to the generalised forces' change with q̈ (exact: F
 //! is linear in q̈), `K v` and `C v` to central differences of F (q̈ = 0) in q and q̇, the
 //! energies to hand formulas; generated code to the interpreter (to the round-off between
-//! libm's and std's sines).
+//! libm's and std's sines), and split functions to whole ones (bit for bit).
 
 use mechgen_runtime::nalgebra::{Const, DefaultAllocator};
 use mechgen_runtime::{EnergyTerms, EquationsOfMotion, Storage, Vector};
@@ -15,6 +15,12 @@ use proptest::prelude::*;
 #[allow(dead_code)]
 mod generated {
     include!(concat!(env!("OUT_DIR"), "/swing_motion.rs"));
+}
+
+// The same with every function split into parts of at most 12 operations.
+#[allow(dead_code)]
+mod split {
+    include!(concat!(env!("OUT_DIR"), "/swing_motion_split.rs"));
 }
 
 use generated::SwingMotion;
@@ -224,6 +230,10 @@ proptest! {
         let ((gm, gk, gc), (im, ik, ic)) = (products(&generated, &s), products(&interpreted, &s));
         prop_assert_eq!((gk.is_some(), gc.is_some()), (ik.is_some(), ic.is_some()));
         let (ge, ie) = (energies(&generated, &s), energies(&interpreted, &s));
+        // Parts of a split body compute exactly what the whole one does.
+        let parts = split::SwingMotion::default();
+        prop_assert_eq!(products(&parts, &s), (gm.clone(), gk.clone(), gc.clone()));
+        prop_assert_eq!(energies(&parts, &s), ge);
         let terms = |e: EnergyTerms| vec![e.gravity, e.springs, e.loads, e.dampers];
         for (what, a, b) in [
             ("M v", gm, im),
@@ -235,6 +245,19 @@ proptest! {
                 prop_assert!(round_off(*x, *y), "{what}: generated {a:?}, interpreted {b:?}");
             }
         }
+    }
+}
+
+#[test]
+fn the_split_kernels_are_split() {
+    let code = include_str!(concat!(env!("OUT_DIR"), "/swing_motion_split.rs"));
+    for part in [
+        "mass_times_part1",
+        "stiffness_times_part1",
+        "damping_times_part1",
+        "energy_terms_part1",
+    ] {
+        assert!(code.contains(part), "{part}");
     }
 }
 
