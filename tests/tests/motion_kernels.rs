@@ -323,6 +323,18 @@ fn the_default_options_emit_no_equations_of_motion() {
         .unwrap_or_else(|e| panic!("{e}"))
         .to_string();
     assert!(!code.contains("EquationsOfMotion"));
+    // The interpreter of such a scene answers NaN and "no kernel", never stale numbers.
+    let scene = mechgen::compile(mechgen::Input::Text(SCENE), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let m = mechgen_interp::Interpreted::new(&scene);
+    let (mass, stiffness, damping) = products(&m, &(vec![0.1; N], vec![0.2; N], vec![1.0; N], 0.3));
+    assert!(mass.iter().all(|v| v.is_nan()) && stiffness.is_none() && damping.is_none());
+    let e = energies(&m, &(vec![0.1; N], vec![0.2; N], vec![], 0.3));
+    assert!(
+        [e.gravity, e.springs, e.loads, e.dampers]
+            .iter()
+            .all(|v| v.is_nan())
+    );
 }
 
 #[test]
