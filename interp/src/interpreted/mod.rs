@@ -176,6 +176,7 @@ impl Interpreted {
             lambda: &[],
             t,
             params: &self.params,
+            free: &[],
         }
     }
 
