@@ -7,6 +7,7 @@
 //! one solver implementation of `mechgen-runtime` with scenes read from `.mech` files, and it
 //! agrees with generated code to the bit.
 
+mod free;
 mod plan;
 mod textbook;
 
@@ -20,6 +21,7 @@ use mechgen::model::physics;
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{Matrix, Names, Outputs, Unit};
 
+use free::FreeDofs;
 use plan::PlanTapes;
 use textbook::{Textbook, unit};
 
@@ -52,6 +54,8 @@ pub struct Interpreted {
     textbook: Textbook,
     /// The plan's kernels as tapes.
     plan: PlanTapes,
+    /// The free degrees of freedom, with the state the tapes read.
+    free: FreeDofs,
     /// Tape slots and output values, reused by every call (evaluation is `&self`).
     scratch: RefCell<Scratch>,
     /// Block Jacobian evaluations so far: the unit of a solve's work, which fuzzing bounds.
@@ -76,8 +80,9 @@ impl Interpreted {
         let (model, kin) = (&scene.model, &scene.kinematics);
         let textbook = Textbook::new(scene);
         let plan = PlanTapes::new(&model.arena, &scene.kernels);
+        let free = FreeDofs::new(scene);
         // One scratch serves every tape: the most instructions and the most outputs of any.
-        let tapes = || textbook.tapes().chain(plan.tapes());
+        let tapes = || textbook.tapes().chain(plan.tapes()).chain([free.tape()]);
         let slots = tapes().map(Tape::len).max().unwrap_or(0);
         let values = tapes().map(Tape::output_count).max().unwrap_or(0).max(1);
         let outputs = match model.outputs {
@@ -116,6 +121,7 @@ impl Interpreted {
             physics: kin.physics.clone(),
             textbook,
             plan,
+            free,
             evaluations: Cell::new(0),
             scratch: RefCell::new(Scratch {
                 slots: vec![0.0; slots],
@@ -176,7 +182,7 @@ impl Interpreted {
             lambda: &[],
             t,
             params: &self.params,
-            free: &[],
+            free: &self.free.state,
         }
     }
 

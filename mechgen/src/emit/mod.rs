@@ -10,6 +10,7 @@ mod body;
 mod checks;
 mod dispatch;
 mod forces;
+mod free;
 mod lu;
 mod markers;
 mod plan;
@@ -77,6 +78,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
     let structured = plan::structured_impl(&cx, &scene.plan, &scene.kernels);
     let accessors = cx.accessors();
     let force_accessors = cx.forces.map(|_| cx.force_accessors());
+    let dynamic = cx.dynamic_impl();
     // Split bodies' parts, collected while the functions above were generated.
     let helpers = cx.helpers.into_inner();
     let name = &scene.model.name;
@@ -97,6 +99,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
         #helpers
         #accessors
         #force_accessors
+        #dynamic
     }
 }
 
@@ -114,16 +117,18 @@ impl Context<'_> {
             quote! { #name: #value, }
         });
         let derived = self.derived_accessors();
+        let (free, free_default) = (self.free_field(), self.free_default());
         quote! {
             #(#docs)*
             #[derive(Debug, Clone, Copy, PartialEq)]
             #vis struct #name {
                 #(#fields)*
+                #free
             }
 
             impl ::core::default::Default for #name {
                 fn default() -> Self {
-                    Self { #(#defaults)* }
+                    Self { #(#defaults)* #free_default }
                 }
             }
 
