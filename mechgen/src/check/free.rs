@@ -51,6 +51,21 @@ impl Checker {
         self.lower(value, true)
     }
 
+    /// A parameter named `free` in a scene with free degrees of freedom: the generated struct
+    /// holds both as fields.
+    pub(super) fn check_free_field(&mut self, spec: &Spec) {
+        if !spec.drivers.iter().any(|d| d.free_keyword().is_some()) {
+            return;
+        }
+        for param in spec.params.iter().filter(|p| p.name == "free") {
+            self.errors.push(
+                param.name.span(),
+                "a scene with `free` degrees of freedom keeps their state in a field named \
+                 `free`; rename this parameter",
+            );
+        }
+    }
+
     /// A scene with free degrees of freedom needs forces among its outputs; run before the
     /// model is built (the outputs decide what it derives).
     pub(super) fn check_free_outputs(&mut self, spec: &Spec, outputs: Outputs) {
@@ -265,6 +280,16 @@ mod tests {
         assert!(
             error
                 .is_some_and(|e| e.starts_with("a free degree of freedom has no prescribed value")),
+        );
+    }
+
+    #[test]
+    fn a_parameter_named_free_is_refused_in_a_free_scene() {
+        let messages = errors("param free = 1; free swing: angle(arm) from free;");
+        assert_eq!(messages.len(), 1, "{messages:?}");
+        assert!(
+            messages[0].contains("rename this parameter"),
+            "{messages:?}"
         );
     }
 }

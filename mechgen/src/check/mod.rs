@@ -64,6 +64,7 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
     cx.check_names(spec);
     let outputs = cx.outputs(spec);
     cx.check_free_outputs(spec, outputs);
+    cx.check_free_field(spec);
 
     let (params, derived) = cx.parameters(spec);
     cx.ground = spec.bodies.iter().map(|b| b.ground).collect();
