@@ -202,12 +202,22 @@ mod tests {
         let source = format!(
             "mechanism M {{ {PENDULUM} free swing: angle(arm) from 0.3; gravity (0, -9.8); }}"
         );
-        let expanded = crate::expand(crate::Input::Text(&source), &crate::Options::default());
-        assert!(
-            expanded.is_ok(),
-            "{:?}",
-            expanded.err().map(|e| e.messages())
-        );
+        // The naive baseline (unsimplified arena) too: γ reads the acceleration ü.
+        for naive in [false, true] {
+            let options = crate::Options {
+                codegen: crate::CodegenOptions {
+                    naive,
+                    ..crate::CodegenOptions::default()
+                },
+                ..crate::Options::default()
+            };
+            let expanded = crate::expand(crate::Input::Text(&source), &options);
+            let code = expanded.map_err(|e| e.messages()).map(|c| c.to_string());
+            assert!(
+                code.is_ok_and(|c| c.contains("self . free [0] [2]")),
+                "naive: {naive}"
+            );
+        }
     }
 
     #[test]
