@@ -621,6 +621,7 @@ where
                 lambda: &[],
                 t,
                 params,
+                free: &[],
             };
             self.phi.eval_generic(inputs, slots, out);
             if let Some(d) = dual_q.get_mut(k) {
@@ -687,6 +688,7 @@ where
             lambda: &[],
             t,
             params: &self.params,
+            free: &[],
         };
         self.phi.eval(inputs, plain_slots, plain_out);
         for (o, v) in out.as_mut_slice().iter_mut().zip(plain_out.iter()) {

@@ -9,6 +9,7 @@
 //! agrees with generated code to the bit.
 
 mod motion;
+mod free;
 mod plan;
 mod textbook;
 
@@ -23,6 +24,7 @@ use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{Matrix, Names, Outputs, Unit};
 
 use motion::MotionTapes;
+use free::FreeDofs;
 use plan::PlanTapes;
 use textbook::{Textbook, unit};
 
@@ -57,6 +59,8 @@ pub struct Interpreted {
     plan: PlanTapes,
     /// The equations of motion, for a scene compiled with them.
     motion: Option<MotionTapes>,
+    /// The free degrees of freedom, with the state the tapes read.
+    free: FreeDofs,
     /// Tape slots and output values, reused by every call (evaluation is `&self`).
     scratch: RefCell<Scratch>,
     /// Block Jacobian evaluations so far: the unit of a solve's work, which fuzzing bounds.
@@ -82,9 +86,12 @@ impl Interpreted {
         let textbook = Textbook::new(scene);
         let plan = PlanTapes::new(&model.arena, &scene.kernels);
         let motion = (scene.motion.as_ref()).map(|m| MotionTapes::new(&model.arena, m));
+        let free = FreeDofs::new(scene);
         // One scratch serves every tape: the most instructions and the most outputs of any.
         let tapes = || {
-            (textbook.tapes().chain(plan.tapes())).chain(motion.iter().flat_map(MotionTapes::tapes))
+            (textbook.tapes().chain(plan.tapes()))
+                .chain(motion.iter().flat_map(MotionTapes::tapes))
+                .chain([free.tape()])
         };
         let slots = tapes().map(Tape::len).max().unwrap_or(0);
         let values = tapes().map(Tape::output_count).max().unwrap_or(0).max(1);
@@ -125,6 +132,7 @@ impl Interpreted {
             textbook,
             plan,
             motion,
+            free,
             evaluations: Cell::new(0),
             scratch: RefCell::new(Scratch {
                 slots: vec![0.0; slots],
@@ -185,6 +193,7 @@ impl Interpreted {
             lambda: &[],
             t,
             params: &self.params,
+            free: &self.free.state,
         }
     }
 

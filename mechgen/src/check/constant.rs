@@ -2,9 +2,7 @@
 //! "2*pi/10"`, `--set gamma=30deg`), written in the scene grammar's expressions without names
 //! other than `pi`, and folded to a number by the same lowering as scene values.
 
-use std::collections::HashMap;
-
-use super::{Checker, Lengths};
+use super::Checker;
 use crate::error::Errors;
 use crate::expr::{Arena, Node};
 use crate::syntax::spec::{Expr, ExprKind};
@@ -26,18 +24,7 @@ pub fn constant_value(text: &str) -> Result<f64, String> {
              degrees and functions, such as `2*pi/10`, `30deg` or `sqrt(2)`"
         ));
     }
-    let mut cx = Checker {
-        errors: Errors::default(),
-        arena: Arena::new(),
-        bodies: HashMap::new(),
-        params: HashMap::new(),
-        derived: HashMap::new(),
-        computing: None,
-        points: HashMap::new(),
-        prismatic: HashMap::new(),
-        ground: Vec::new(),
-        lengths: Lengths::default(),
-    };
+    let mut cx = Checker::new(Errors::default(), Arena::new());
     let id = cx.lower_with(&expr, false, false);
     if let Some(message) = cx.errors.messages().into_iter().next() {
         return Err(message);

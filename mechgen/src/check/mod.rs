@@ -15,6 +15,7 @@
 mod branches;
 mod constant;
 mod dynamics;
+mod free;
 mod functions;
 mod library;
 mod lower;
@@ -36,7 +37,7 @@ use std::collections::HashMap;
 use crate::error::Errors;
 use crate::expr::{Arena, Id};
 use crate::model::{Body, Branch, Constraint, ConstraintKind, Model, Point};
-use crate::syntax::spec::Spec;
+use crate::syntax::spec::{DriverValue, Spec};
 use resolution::Lengths;
 
 /// Checks a spec and builds its model.
@@ -62,6 +63,8 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
     let mut cx = Checker::new(errors, arena);
     cx.check_names(spec);
     let outputs = cx.outputs(spec);
+    cx.check_free_outputs(spec, outputs);
+    cx.check_free_field(spec);
 
     let (params, derived) = cx.parameters(spec);
     cx.ground = spec.bodies.iter().map(|b| b.ground).collect();
@@ -98,11 +101,15 @@ pub fn check_into(spec: &Spec, arena: Arena) -> Result<Model, Errors> {
         loads,
         markers,
         outputs,
+        frees: std::mem::take(&mut cx.frees),
     };
     if count {
         let rows = Structure::rows_of(&mut model);
         let structure = Structure::of_pattern(&rows, model.dim());
         cx.check_mobility(spec, &model, &structure, &rows);
+        if cx.errors.is_empty() {
+            cx.check_free_masses(spec, &model, &rows);
+        }
     }
     cx.lengths.check(&mut cx.errors);
     cx.errors.finish()?;
@@ -126,6 +133,8 @@ struct Checker {
     /// Prismatic joints by name, for `travel` drivers: (a, b, unit axis).
     prismatic: HashMap<String, (Point, Point, [Id; 2])>,
     ground: Vec<bool>,
+    /// Free degrees of freedom, as their drivers are checked.
+    frees: Vec<crate::model::Free>,
     /// Constant lengths, for the range and resolution rules.
     lengths: Lengths,
 }
@@ -142,6 +151,7 @@ impl Checker {
             points: HashMap::new(),
             prismatic: HashMap::new(),
             ground: Vec::new(),
+            frees: Vec::new(),
             lengths: Lengths::default(),
         }
     }
@@ -194,7 +204,12 @@ impl Checker {
         }
         for driver in &spec.drivers {
             let driven = self.driven(driver.kind_span, &driver.kind);
-            let value = self.lower(&driver.value, true);
+            let value = match &driver.value {
+                DriverValue::Prescribed(value) => self.lower(value, true),
+                DriverValue::Free { from, speed, .. } => {
+                    self.free(driver, from.as_ref(), speed.as_ref(), constraints.len())
+                }
+            };
             if let Some(driven) = driven {
                 constraints.push(Constraint {
                     name: driver.name.to_string(),

@@ -265,7 +265,11 @@ impl Context<'_> {
             .filter(|(_, id)| !arena.is_zero(*id))
             .collect();
         let roots: Vec<Id> = nonzero.iter().map(|(_, id)| *id).collect();
-        let order = topological_order_with(arena, &roots, |id| cached.contains_key(&id));
+        // A free degree of freedom's state is read from `self`, not computed from its operand
+        // `t`: a leaf here, so a body that reads it does not take `t` for it.
+        let order = topological_order_with(arena, &roots, |id| {
+            cached.contains_key(&id) || matches!(arena.node(id), Node::Free { .. })
+        });
         let counts = if self.options.naive {
             OpCounts::of_tree(arena, &roots)
         } else {
@@ -407,7 +411,10 @@ impl<'w, 'a> Writer<'w, 'a> {
             return;
         }
         let (tokens, prec) = self.render(node);
-        let is_leaf = matches!(node, Node::Const(_) | Node::Param(_) | Node::Var(Var::T));
+        let is_leaf = matches!(
+            node,
+            Node::Const(_) | Node::Param(_) | Node::Var(Var::T) | Node::Free { .. }
+        );
         // Coordinates are loaded once; the naive baseline shares nothing else.
         let call = matches!(node, Node::Call(..) | Node::Call2(..) | Node::Spline { .. });
         let shared = call || self.uses.get(&id).copied().unwrap_or(0) > 1;
@@ -520,6 +527,10 @@ impl<'w, 'a> Writer<'w, 'a> {
                 let order = Literal::u8_unsuffixed(order);
                 let x = self.operand(x).0;
                 (quote!(Self::#table.eval(#x, #order)), Prec::Atom)
+            }
+            Node::Free { dof, order, .. } => {
+                let (dof, order) = (idx(dof as usize), idx(usize::from(order)));
+                (quote!(self.free[#dof][#order]), Prec::Atom)
             }
         }
     }

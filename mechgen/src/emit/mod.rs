@@ -11,6 +11,7 @@ mod body;
 mod checks;
 mod dispatch;
 mod forces;
+mod free;
 mod lu;
 mod markers;
 mod motion;
@@ -86,6 +87,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
     let accessors = cx.accessors();
     let force_accessors = cx.forces.map(|_| cx.force_accessors());
     let motion = scene.motion.as_ref().map(|eom| cx.motion_impl(eom));
+    let dynamic = cx.dynamic_impl();
     // Split bodies' parts, collected while the functions above were generated.
     let helpers = cx.helpers.into_inner();
     let name = &scene.model.name;
@@ -107,6 +109,7 @@ pub fn emit_with(scene: &Scene, options: &CodegenOptions) -> TokenStream {
         #accessors
         #force_accessors
         #motion
+        #dynamic
     }
 }
 
@@ -124,16 +127,18 @@ impl Context<'_> {
             quote! { #name: #value, }
         });
         let derived = self.derived_accessors();
+        let (free, free_default) = (self.free_field(), self.free_default());
         quote! {
             #(#docs)*
             #[derive(Debug, Clone, Copy, PartialEq)]
             #vis struct #name {
                 #(#fields)*
+                #free
             }
 
             impl ::core::default::Default for #name {
                 fn default() -> Self {
-                    Self { #(#defaults)* }
+                    Self { #(#defaults)* #free_default }
                 }
             }
 

@@ -91,6 +91,18 @@ impl Differentiator {
                     arena.mul(outer, dx)
                 }
             }
+            // d/dt raises the order; the acceleration's derivative is zero (`Arena::free`):
+            // a driver's value is differentiated at most twice (γ needs Φ_tt), so no kernel
+            // ever reads a third derivative of the state.
+            Node::Free { dof, order, t } => {
+                let dt = self.diff(arena, t, var);
+                if arena.is_zero(dt) && arena.simplifies() {
+                    arena.zero()
+                } else {
+                    let rate = arena.free(dof, order.saturating_add(1), t);
+                    arena.mul(rate, dt)
+                }
+            }
         };
         self.memo.insert((e, var), d);
         d
@@ -247,6 +259,7 @@ mod tests {
             qdd: vec![],
             t: 0.4,
             params: vec![],
+            free: Vec::new(),
         };
         let mut d = Differentiator::new();
         for &e in &cases {
@@ -281,6 +294,7 @@ mod tests {
             qdd: vec![0.4, -1.1],
             t: 0.8,
             params: vec![],
+            free: Vec::new(),
         };
         let [x, th] = [1.5_f64, 0.3];
         let [xd, thd] = [-0.7_f64, 2.0];
@@ -304,5 +318,42 @@ mod tests {
         let dx = d.diff(&mut a, s, Var::Q(0));
         let dt = d.diff(&mut a, s, Var::T);
         assert!(a.is_zero(dx) && a.is_zero(dt));
+    }
+
+    #[test]
+    fn a_free_state_differentiates_along_time_to_its_rate_then_acceleration() {
+        // Φ = x − u(t) for a free u: Φ_t = −u̇, Φ_tt = −ü, and ü's own derivative is zero (the
+        // integrator's state ends at the acceleration).
+        let mut a = Arena::new();
+        let (x, t) = (a.var(Var::Q(0)), a.var(Var::T));
+        let u = a.free(1, 0, t);
+        let phi = a.sub(x, u);
+        let mut d = Differentiator::new();
+        let phi_t = d.diff(&mut a, phi, Var::T);
+        let phi_tt = d.diff(&mut a, phi_t, Var::T);
+        let (rate, acceleration) = (a.free(1, 1, t), a.free(1, 2, t));
+        assert_eq!(phi_t, a.neg(rate));
+        assert_eq!(phi_tt, a.neg(acceleration));
+        let (third, by_q) = (
+            d.diff(&mut a, acceleration, Var::T),
+            d.diff(&mut a, u, Var::Q(0)),
+        );
+        assert!(a.is_zero(third) && a.is_zero(by_q));
+        // It depends on time: no rule may treat it as a constant.
+        assert!(a.depends_on(u, Var::T) && !a.is_invariant(u));
+        // Along the motion: d/dt (x u) = ẋ u + x u̇, evaluated with the state by hand.
+        let xu = a.mul(x, u);
+        let rate_of_xu = d.time_derivative(&mut a, xu);
+        let env = Env {
+            q: vec![2.0],
+            qd: vec![-0.5],
+            qdd: vec![],
+            t: 0.1,
+            params: vec![],
+            free: vec![[f64::NAN; 3], [0.3, 1.7, -4.0]],
+        };
+        let exact = -0.5 * 0.3 + 2.0 * 1.7;
+        assert!((eval(&a, rate_of_xu, &env) - exact).abs() < 1e-15);
+        assert_eq!(eval(&a, phi_tt, &env), 4.0);
     }
 }

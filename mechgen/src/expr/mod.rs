@@ -197,6 +197,18 @@ pub enum Node {
         /// The argument.
         x: Id,
     },
+    /// The integrator's state of free degree of freedom `dof`: its value, rate or
+    /// acceleration (`order` 0, 1, 2) at time `t` ([`Arena::free`]). A function of time only,
+    /// like a driver's law: it carries `t` as its operand so that every rule about time
+    /// dependence (ν, γ, what the trig cache may hold) sees it as time-dependent.
+    Free {
+        /// Index of the free degree of freedom, in declaration order.
+        dof: u32,
+        /// 0: the value u, 1: the rate u̇, 2: the acceleration ü.
+        order: u8,
+        /// The time variable.
+        t: Id,
+    },
 }
 
 /// The arena holding every node; see the module docs.
@@ -559,13 +571,25 @@ impl Arena {
         }
     }
 
+    /// The `order`-th time derivative of free degree of freedom `dof`'s state at `t` (the
+    /// variable `t`). Orders above 2 are zero: the integrator's state ends at the acceleration,
+    /// and nothing needs more (γ differentiates a driver's value twice, from order 0).
+    pub fn free(&mut self, dof: u32, order: u8, t: Id) -> Id {
+        if order > 2 {
+            return self.zero;
+        }
+        self.intern(Node::Free { dof, order, t })
+    }
+
     /// The operands of a node, in order.
     pub fn children(&self, id: Id) -> impl Iterator<Item = Id> {
         let operands: [Option<Id>; 4] = match self.node(id) {
             Node::Const(_) | Node::Param(_) | Node::Var(_) => [None; 4],
-            Node::Neg(a) | Node::Powi(a, _) | Node::Call(_, a) | Node::Spline { x: a, .. } => {
-                [Some(a), None, None, None]
-            }
+            Node::Neg(a)
+            | Node::Powi(a, _)
+            | Node::Call(_, a)
+            | Node::Spline { x: a, .. }
+            | Node::Free { t: a, .. } => [Some(a), None, None, None],
             Node::Add(a, b)
             | Node::Sub(a, b)
             | Node::Mul(a, b)
@@ -606,6 +630,9 @@ impl Arena {
                 Node::Call2(f, a, b) => self.call2(f, get(a), get(b)),
                 Node::Select(a, b, x, y) => self.select(get(a), get(b), get(x), get(y)),
                 Node::Spline { table, order, x } => self.spline(table, order, get(x)),
+                // Substituting a value for `t` leaves the state a function of the time it is
+                // read at: the node keeps its operand.
+                Node::Free { .. } => id,
             };
             memo.insert(id, rebuilt);
         }

@@ -75,6 +75,8 @@ pub struct Env {
     pub t: f64,
     /// Parameter values by declaration index.
     pub params: Vec<f64>,
+    /// The free degrees of freedom's `[value, rate, acceleration]`, by declaration index.
+    pub free: Vec<[f64; 3]>,
 }
 
 /// Inputs of one evaluation, borrowed (so callers need not copy into an [`Env`]).
@@ -98,6 +100,8 @@ pub struct Inputs<'a, S = f64> {
     pub t: f64,
     /// Parameter values by declaration index.
     pub params: &'a [f64],
+    /// The free degrees of freedom's `[value, rate, acceleration]` (empty in a scene without).
+    pub free: &'a [[f64; 3]],
 }
 
 impl Env {
@@ -111,6 +115,7 @@ impl Env {
             lambda: &[],
             t: self.t,
             params: &self.params,
+            free: &self.free,
         }
     }
 }
@@ -147,6 +152,8 @@ enum Op {
     Select(usize, usize, usize, usize),
     /// A spline table (index into the tape's own), derivative order, argument.
     Spline(usize, u8, usize),
+    /// Free degree of freedom, order (its state is an input, like a parameter).
+    Free(usize, usize),
 }
 
 /// A set of outputs compiled to straight-line instructions.
@@ -205,6 +212,7 @@ impl Tape {
                     });
                     Op::Spline(index, order, s(x))
                 }
+                Node::Free { dof, order, .. } => Op::Free(dof as usize, usize::from(order)),
             };
             slot.insert(id, ops.len());
             ops.push(op);
@@ -278,6 +286,14 @@ impl Tape {
                 Op::Lambda(i) => S::from_f64(inputs.lambda.get(i).copied().unwrap_or(f64::NAN)),
                 Op::Cached(k) => S::from_f64(inputs.trig.get(k).copied().unwrap_or(f64::NAN)),
                 Op::T => S::from_f64(inputs.t),
+                Op::Free(k, order) => S::from_f64(
+                    inputs
+                        .free
+                        .get(k)
+                        .and_then(|state| state.get(order))
+                        .copied()
+                        .unwrap_or(f64::NAN),
+                ),
                 Op::Neg(a) => -scratch[a],
                 Op::Add(a, b) => scratch[a] + scratch[b],
                 Op::Sub(a, b) => scratch[a] - scratch[b],
@@ -376,6 +392,7 @@ mod tests {
             qdd: vec![],
             t: 2.0,
             params: vec![3.0],
+            free: Vec::new(),
         };
         let mut scratch = tape.scratch();
         let mut out = [0.0; 2];
@@ -459,6 +476,7 @@ mod tests {
             lambda: &[],
             t: 0.0,
             params: &[p0],
+            free: &[],
         };
         tape.eval_generic(inputs, &mut tape.scratch_of(), &mut out);
         let plain = eval(
@@ -470,6 +488,7 @@ mod tests {
                 qdd: vec![],
                 t: 0.0,
                 params: vec![p0],
+                free: Vec::new(),
             },
         );
         assert_eq!(out[0].0, plain);
@@ -488,5 +507,22 @@ mod tests {
         let x = a.var(Var::Q(7));
         let env = Env::default();
         assert!(eval(&a, x, &env).is_nan());
+    }
+
+    #[test]
+    fn a_free_state_is_read_from_the_inputs_and_missing_reads_nan() {
+        let mut a = Arena::new();
+        let t = a.var(Var::T);
+        let (u, ud) = (a.free(0, 0, t), a.free(0, 1, t));
+        let sum = a.add(u, ud);
+        let far = a.free(3, 2, t);
+        let env = Env {
+            free: vec![[0.25, 2.0, 9.0]],
+            ..Env::default()
+        };
+        assert_eq!(eval(&a, sum, &env), 2.25);
+        assert!(eval(&a, far, &env).is_nan());
+        let third = a.free(0, 3, t);
+        assert!(a.is_zero(third));
     }
 }

@@ -341,6 +341,7 @@ mod tests {
             qdd: vec![0.0, 0.0, 0.0, 0.05, 0.6, thdd],
             t: 0.0,
             params: vec![],
+            free: Vec::new(),
         };
         let f = forces(PENDULUM, &env);
         assert_eq!(&f[..3], &[0.0; 3]);
@@ -377,6 +378,7 @@ mod tests {
             qdd: vec![0.0; 6],
             t: 0.25,
             params: vec![],
+            free: Vec::new(),
         };
         let f = forces(source, &env);
         // Stretched by 0.5 at 0.5/s: tension 10 · 0.5 + 2 · 0.5 = 6, pulling towards the frame.

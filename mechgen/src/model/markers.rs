@@ -100,6 +100,7 @@ mod tests {
             qdd: vec![0.0; 9],
             t: 0.0,
             params: vec![],
+            free: Vec::new(),
         };
         let values: Vec<f64> = scene
             .kinematics

@@ -54,6 +54,22 @@ pub struct Model {
     pub markers: Vec<Marker>,
     /// What the scene asked to compute.
     pub outputs: Outputs,
+    /// Free degrees of freedom in declaration order (each a [`ConstraintKind::Driver`] whose
+    /// value is its [`Node::Free`](crate::expr::Node::Free) state).
+    pub frees: Vec<Free>,
+}
+
+/// A free degree of freedom: a driver whose value `u` is the integrator's state.
+#[derive(Clone)]
+pub struct Free {
+    /// Name as declared (its equation's name; its reaction is `NAME.effort`).
+    pub name: Ident,
+    /// Its driver's index in [`Model::constraints`].
+    pub constraint: usize,
+    /// The declared initial value, in parameters (`None`: the assembled guess's).
+    pub from: Option<Id>,
+    /// The declared initial rate, in parameters (0 unless declared).
+    pub speed: Id,
 }
 
 /// Which kinematic outputs a scene computes (the spec's `outputs` line; default all three).
@@ -487,6 +503,17 @@ impl Model {
     /// Number of coordinates (= number of equations, checked).
     pub fn dim(&self) -> usize {
         3 * self.bodies.len()
+    }
+
+    /// The equation (row of Φ) that holds free degree of freedom `k` at its state.
+    pub fn free_equation(&self, k: usize) -> Option<usize> {
+        let free = self.frees.get(k)?;
+        Some(
+            self.constraints[..free.constraint]
+                .iter()
+                .map(|c| c.kind.equation_suffixes().len())
+                .sum(),
+        )
     }
 
     /// Coordinate names in q order: `piston.x`, `piston.y`, `piston.theta`, …

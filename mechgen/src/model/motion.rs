@@ -119,6 +119,7 @@ mod tests {
             qdd: vec![0.0; q.len()],
             t: 0.3,
             params: vec![],
+            free: Vec::new(),
         }
     }
 

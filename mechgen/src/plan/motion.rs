@@ -27,10 +27,11 @@ pub struct EquationsOfMotion {
     pub energy: Energy,
 }
 
-/// Whether a scene carries its equations of motion: a scene that computes forces, when
-/// `asked` (`CodegenOptions::equations_of_motion`).
+/// Whether a scene carries its equations of motion: a scene that computes forces, when it
+/// declares free degrees of freedom (the integrator needs them) or when `asked`
+/// (`CodegenOptions::equations_of_motion`: M, K and C of a prescribed motion).
 pub fn needs_motion(model: &Model, asked: bool) -> bool {
-    model.outputs >= Outputs::Forces && asked
+    model.outputs >= Outputs::Forces && (asked || !model.frees.is_empty())
 }
 
 /// The equations of motion of `model`, from its generalised forces `F = Q − M q̈`.

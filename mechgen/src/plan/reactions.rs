@@ -419,6 +419,7 @@ mod tests {
             lambda,
             t: 0.0,
             params: &[],
+            free: &[],
         };
         let mut out = [0.0];
         tape.eval(inputs, &mut tape.scratch(), &mut out);

@@ -36,7 +36,7 @@ impl OpCounts {
         let mut c = OpCounts::default();
         for &id in order {
             match arena.node(id) {
-                Node::Const(_) | Node::Param(_) | Node::Var(_) => {}
+                Node::Const(_) | Node::Param(_) | Node::Var(_) | Node::Free { .. } => {}
                 Node::Neg(_) => c.neg += 1,
                 Node::Add(..) | Node::Sub(..) => c.add += 1,
                 Node::Mul(..) => c.mul += 1,

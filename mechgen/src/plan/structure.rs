@@ -580,6 +580,7 @@ impl Planner<'_> {
             lambda: &[],
             t: 0.0,
             params: &self.params,
+            free: &[],
         };
         tape.eval(inputs, &mut tape.scratch(), &mut out);
         out
@@ -747,6 +748,7 @@ mod tests {
             qdd: vec![0.0; 12],
             t: 0.1,
             params: Vec::new(),
+            free: Vec::new(),
         };
         let (s, c) = angle.sin_cos();
         let expected = [

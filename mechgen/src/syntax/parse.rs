@@ -10,9 +10,9 @@ use syn::parse::{Parse, ParseStream};
 use syn::{Attribute, Ident, LitFloat, LitInt, Token, Visibility, braced, parenthesized};
 
 use crate::syntax::spec::{
-    BinOp, BodyDecl, BranchDecl, DriverDecl, DriverKind, Expr, ExprKind, GravityDecl, JointDecl,
-    JointKind, LoadDecl, LoadKind, MarkerDecl, MarkerKind, MassDecl, ParamDecl, PointDecl,
-    PointRef, Product, Sign, Spec,
+    BinOp, BodyDecl, BranchDecl, DriverDecl, DriverKind, DriverValue, Expr, ExprKind, GravityDecl,
+    JointDecl, JointKind, LoadDecl, LoadKind, MarkerDecl, MarkerKind, MassDecl, ParamDecl,
+    PointDecl, PointRef, Product, Sign, Spec,
 };
 
 mod kw {
@@ -22,6 +22,9 @@ mod kw {
     syn::custom_keyword!(body);
     syn::custom_keyword!(joint);
     syn::custom_keyword!(driver);
+    syn::custom_keyword!(free);
+    syn::custom_keyword!(from);
+    syn::custom_keyword!(speed);
     syn::custom_keyword!(at);
     syn::custom_keyword!(near);
     syn::custom_keyword!(along);
@@ -158,7 +161,20 @@ pub(crate) fn statement(input: ParseStream, spec: &mut Spec) -> syn::Result<()> 
         input.parse::<Token![:]>()?;
         let (kind_span, kind) = driver_kind(input)?;
         input.parse::<Token![=]>()?;
-        let value = input.parse()?;
+        let value = DriverValue::Prescribed(input.parse()?);
+        spec.drivers.push(DriverDecl {
+            docs,
+            name,
+            kind_span,
+            kind,
+            value,
+        });
+    } else if look.peek(kw::free) {
+        let keyword = input.parse::<kw::free>()?.span;
+        let name = input.parse()?;
+        input.parse::<Token![:]>()?;
+        let (kind_span, kind) = driver_kind(input)?;
+        let value = free_value(input, keyword)?;
         spec.drivers.push(DriverDecl {
             docs,
             name,
@@ -585,6 +601,34 @@ fn driver_kind(input: ParseStream) -> syn::Result<(proc_macro2::Span, DriverKind
         return Err(args.error(format!("unexpected argument: {advice}")));
     }
     Ok((kind.span(), driver))
+}
+
+/// `[from u0] [speed v0]` after a free degree of freedom's kind, in this order.
+fn free_value(input: ParseStream, keyword: proc_macro2::Span) -> syn::Result<DriverValue> {
+    let from = if input.peek(kw::from) {
+        input.parse::<kw::from>()?;
+        Some(input.parse()?)
+    } else {
+        None
+    };
+    let speed = if input.peek(kw::speed) {
+        input.parse::<kw::speed>()?;
+        Some(input.parse()?)
+    } else {
+        None
+    };
+    if input.peek(Token![=]) {
+        return Err(input.error(
+            "a free degree of freedom has no prescribed value: the forces move it; write \
+             `free NAME: KIND(…) from u0 speed v0;` for its initial state, or `driver NAME: \
+             KIND(…) = f(t);` to prescribe it",
+        ));
+    }
+    Ok(DriverValue::Free {
+        keyword,
+        from,
+        speed,
+    })
 }
 
 /// How a driver of `driver`'s kind is written, for an error about its arguments.

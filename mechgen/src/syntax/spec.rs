@@ -20,7 +20,7 @@ pub struct Spec {
     pub bodies: Vec<BodyDecl>,
     /// Joints in declaration order.
     pub joints: Vec<JointDecl>,
-    /// Drivers in declaration order.
+    /// Drivers and free degrees of freedom, in declaration order.
     pub drivers: Vec<DriverDecl>,
     /// Branch invariants in declaration order.
     pub branches: Vec<BranchDecl>,
@@ -308,7 +308,8 @@ impl JointKind {
     }
 }
 
-/// `driver NAME: KIND(...) = f(t);`
+/// `driver NAME: KIND(...) = f(t);` or `free NAME: KIND(...) [from u0] [speed v0];`: one
+/// equation holding a quantity at a value, prescribed or the integrator's state.
 #[derive(Clone)]
 pub struct DriverDecl {
     /// Doc comments.
@@ -319,8 +320,35 @@ pub struct DriverDecl {
     pub kind_span: Span,
     /// What is driven.
     pub kind: DriverKind,
-    /// The prescribed value as a function of t and parameters.
-    pub value: Expr,
+    /// The value it is held at.
+    pub value: DriverValue,
+}
+
+/// The value a [`DriverDecl`] holds its quantity at.
+#[derive(Clone)]
+pub enum DriverValue {
+    /// `= f(t)`: a prescribed function of t and parameters.
+    Prescribed(Expr),
+    /// `free`: a free degree of freedom, moved by the integrator under the scene's forces.
+    Free {
+        /// Span of the `free` keyword.
+        keyword: Span,
+        /// `from u0`: the initial value, in parameters (default: the value at the scene's
+        /// initial guess, assembled).
+        from: Option<Expr>,
+        /// `speed v0`: the initial rate, in parameters (default 0).
+        speed: Option<Expr>,
+    },
+}
+
+impl DriverDecl {
+    /// The `free` keyword's span if this declares a free degree of freedom.
+    pub fn free_keyword(&self) -> Option<Span> {
+        match self.value {
+            DriverValue::Free { keyword, .. } => Some(keyword),
+            DriverValue::Prescribed(_) => None,
+        }
+    }
 }
 
 /// What a driver prescribes.

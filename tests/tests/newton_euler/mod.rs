@@ -58,6 +58,7 @@ impl NewtonEuler<'_> {
             qdd: Vec::new(),
             t: self.t,
             params: self.params.clone(),
+            free: Vec::new(),
         };
         mechgen::expr::tape::eval(&self.scene.model.arena, id, &env)
     }
