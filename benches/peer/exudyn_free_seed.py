@@ -232,10 +232,13 @@ def main():
     parser.add_argument("--repeats", type=int, default=7, help="timed runs, default 7")
     parser.add_argument("--reference-only", action="store_true",
                         help="print the reference only (no Exudyn)")
+    parser.add_argument("--summary", action="store_true",
+                        help="print one line `exudyn key=value ...` only (for the Rust benchmark)")
     args = parser.parse_args()
 
     ref, how = reference(REPORT_TIMES)
-    print(f"reference: reduced Lagrange equation of the free seed, {how}")
+    if not args.summary:
+        print(f"reference: reduced Lagrange equation of the free seed, {how}")
     if args.reference_only:
         for t, phi in zip(REPORT_TIMES, ref):
             print(f"  t = {t:.1f} s   phi = {phi:.12f} rad")
@@ -251,7 +254,13 @@ def main():
     steps, newton, jacobians = runs[0][1]
     angles = runs[0][2]
     if any(r[2] != angles for r in runs):
-        print("warning: repeated runs disagree on the crank angle")
+        print("warning: repeated runs disagree on the crank angle", file=sys.stderr)
+    worst = max(abs(a - b) for a, b in zip(angles, ref))
+    if args.summary:
+        print(f"exudyn version={exu.__version__} step={args.step:g} rho_inf={args.rho_inf} "
+              f"us_per_step_median={statistics.median(per_step) * 1e6:.3f} "
+              f"us_per_step_fastest={min(per_step) * 1e6:.3f} max_abs_dphi={worst:.3e}")
+        return
     print(f"Exudyn {exu.__version__}, Python {sys.version.split()[0]}: generalized-alpha "
           f"(index 3), rho_inf = {args.rho_inf}, fixed step h = {args.step:g} s, "
           f"{steps} steps to {T_END} s ({newton / steps:.2f} Newton iterations per step, "
@@ -259,7 +268,6 @@ def main():
     print(f"  {'t (s)':>6} {'Exudyn phi (rad)':>18} {'reference (rad)':>18} {'|dphi| (rad)':>12}")
     for t, phi, phi_ref in zip(REPORT_TIMES, angles, ref):
         print(f"  {t:>6.1f} {phi:>18.12f} {phi_ref:>18.12f} {abs(phi - phi_ref):>12.3e}")
-    worst = max(abs(a - b) for a, b in zip(angles, ref))
     print()
     print(f"  {'peer':<10} {'us/step (median)':>17} {'us/step (fastest)':>18} {'max |dphi| (rad)':>17}")
     print(f"  {'Exudyn':<10} {statistics.median(per_step) * 1e6:>17.2f} "
