@@ -173,7 +173,8 @@ def build(exu, rho_inf, step):
         return mbs.AddMarker(items.MarkerBodyRigid(bodyNumber=body, localPosition=[0.0, 0.0, 0.0]))
 
     revolute = items.ObjectJointRevolute2D
-    mbs.AddObject(revolute(markerNumbers=[point(rod, ROD_PIN_CRANK), point(crank, (0.0, CRANK_RADIUS))]))
+    mbs.AddObject(revolute(
+        markerNumbers=[point(rod, ROD_PIN_CRANK), point(crank, (0.0, CRANK_RADIUS))]))
     mbs.AddObject(revolute(markerNumbers=[point(piston, PISTON_PIN), point(rod, ROD_PIN_PISTON)]))
     mbs.AddObject(revolute(markerNumbers=[point(crank, (0.0, 0.0)), point(bearing, (0.0, 0.0))]))
     # The piston's reference point on the liner's x axis, no relative rotation.
@@ -269,7 +270,8 @@ def main():
     for t, phi, phi_ref in zip(REPORT_TIMES, angles, ref):
         print(f"  {t:>6.1f} {phi:>18.12f} {phi_ref:>18.12f} {abs(phi - phi_ref):>12.3e}")
     print()
-    print(f"  {'peer':<10} {'us/step (median)':>17} {'us/step (fastest)':>18} {'max |dphi| (rad)':>17}")
+    print(f"  {'peer':<10} {'us/step (median)':>17} {'us/step (fastest)':>18} "
+          f"{'max |dphi| (rad)':>17}")
     print(f"  {'Exudyn':<10} {statistics.median(per_step) * 1e6:>17.2f} "
           f"{min(per_step) * 1e6:>18.2f} {worst:>17.3e}")
 
