@@ -1,5 +1,6 @@
-//! The n-stage scissor lift, assembled with `mechgen::builder`: shared by `build.rs` and the
-//! `generation_cost` example (each declares the `geometry` module this uses at its root).
+//! The n-stage scissor lift, assembled with `mechgen::builder`: shared by `build.rs`, the
+//! `generation_cost` example and `mechgen-growth`'s build script, whose falling lift reuses the
+//! linkage (each declares the `geometry` module this uses at its root).
 
 use mechgen::builder::SceneBuilder;
 
@@ -13,10 +14,6 @@ use crate::geometry::{ALPHA0, LINK_LENGTH, OMEGA, stage_poses, stage_width};
 /// hinge, the roller's track and its pin 2 + 2 + 2: 6n + 8 equations, so 1 degree of freedom,
 /// taken by the driver on the bottom link's angle.
 pub fn scissor_lift(stages: usize) -> SceneBuilder {
-    let half = LINK_LENGTH / 2.0;
-    let width = stage_width(ALPHA0);
-    let height = crate::geometry::platform_height(stages, ALPHA0);
-    let top = stages.saturating_sub(1);
     let mut scene = SceneBuilder::new("ScissorLift");
     scene
         .doc(&format!(
@@ -30,19 +27,40 @@ pub fn scissor_lift(stages: usize) -> SceneBuilder {
     scene
         .param("omega", OMEGA)
         .item_doc("Rate at which the links rise (rad/s).");
-    scene.ground("base", [0.0, 0.0, 0.0]);
+    linkage(&mut scene, stages, |scene, name, pose| {
+        scene.body(name, pose);
+    });
     scene
-        .body("slider", [width, 0.0, 0.0])
-        .item_doc("Carries the bottom stage's lower-right end along the ground.");
+        .driver_angle("lift", "rise_0", "alpha0 + omega * t")
+        .item_doc("The bottom link's angle, α(t) = alpha0 + omega t.");
+    scene
+}
+
+/// The lift's bodies and joints, for `stages` ≥ 1 stages at α = `ALPHA0`: the ground `base`,
+/// then each moving body added by `body(scene, name, pose)` (`slider`, `rise_k` and `fall_k`
+/// for each stage k, `platform`, `roller`; documented by the `item_doc` this adds after it),
+/// then the joints. One degree of freedom is left for the caller to drive or set free.
+pub fn linkage(
+    scene: &mut SceneBuilder,
+    stages: usize,
+    mut body: impl FnMut(&mut SceneBuilder, &str, [f64; 3]),
+) {
+    let half = LINK_LENGTH / 2.0;
+    let width = stage_width(ALPHA0);
+    let height = crate::geometry::platform_height(stages, ALPHA0);
+    let top = stages.saturating_sub(1);
+    scene.ground("base", [0.0, 0.0, 0.0]);
+    body(scene, "slider", [width, 0.0, 0.0]);
+    scene.item_doc("Carries the bottom stage's lower-right end along the ground.");
     for k in 0..stages {
         let [rise, fall] = stage_poses(k, ALPHA0);
-        scene.body(&format!("rise_{k}"), rise);
-        scene.body(&format!("fall_{k}"), fall);
+        body(scene, &format!("rise_{k}"), rise);
+        body(scene, &format!("fall_{k}"), fall);
     }
+    body(scene, "platform", [0.0, height, 0.0]);
     scene
-        .body("platform", [0.0, height, 0.0])
         .item_doc("The platform: its reference point is hinged on the top stage's upper-left end.");
-    scene.body("roller", [width, height, 0.0]);
+    body(scene, "roller", [width, height, 0.0]);
 
     scene.revolute("anchor", "base", ("rise_0", [-half, 0.0]));
     scene.prismatic("rail", "base", "slider", [1.0, 0.0]);
@@ -69,8 +87,4 @@ pub fn scissor_lift(stages: usize) -> SceneBuilder {
     scene.revolute("hinge", "platform", (format!("fall_{top}"), [half, 0.0]));
     scene.prismatic("track", "platform", "roller", [1.0, 0.0]);
     scene.revolute("roller_pin", "roller", (format!("rise_{top}"), [half, 0.0]));
-    scene
-        .driver_angle("lift", "rise_0", "alpha0 + omega * t")
-        .item_doc("The bottom link's angle, α(t) = alpha0 + omega t.");
-    scene
 }

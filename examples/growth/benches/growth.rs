@@ -9,6 +9,8 @@
 //!
 //! `cargo bench -p mechgen-growth`
 
+mod fit;
+
 use std::cell::RefCell;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -93,14 +95,6 @@ fn main() {
         );
     }
     if points.len() >= 2 {
-        let logs: Vec<(f64, f64)> = points.iter().map(|(n, t)| (n.ln(), t.ln())).collect();
-        let mean_x = logs.iter().map(|p| p.0).sum::<f64>() / logs.len() as f64;
-        let mean_y = logs.iter().map(|p| p.1).sum::<f64>() / logs.len() as f64;
-        let (mut sxy, mut sxx) = (0.0, 0.0);
-        for (x, y) in &logs {
-            sxy += (x - mean_x) * (y - mean_y);
-            sxx += (x - mean_x) * (x - mean_x);
-        }
-        println!("  fitted exponent: time ∝ N^{:.3}", sxy / sxx);
+        println!("  fitted exponent: time ∝ N^{:.3}", fit::exponent(&points));
     }
 }

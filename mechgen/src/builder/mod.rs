@@ -37,8 +37,10 @@
 //! than the expansion itself on large scenes.
 //!
 //! This file is the builder's API; its arguments ([`Value`], [`Point`]) are in `values`, the
-//! token formatter ([`source_text`]) in `text`, and the file writing in `write`.
+//! token formatter ([`source_text`]) in `text`, the file writing in `write`, and the `free`
+//! statements of forward dynamics in `free`.
 
+mod free;
 mod text;
 mod values;
 mod write;
