@@ -1,6 +1,7 @@
 //! The example scenes, declared with `mechanism!`. Each has a `.mech` twin in `scenes/` for the
 //! CLI; a test holds the two to the same tokens. `PistonCrankDynamics` is the seed with mass
-//! properties and gravity: the force solve's example; `Hoeken` and `Planetary` show markers
+//! properties and gravity: the force solve's example; `PistonCrankFree` the same with its crank
+//! free, moving under gravity (forward dynamics); `Hoeken` and `Planetary` show markers
 //! and gears.
 
 use mechgen_runtime::mechanism;
@@ -62,6 +63,39 @@ mechanism! {
         joint slide: prismatic(liner, piston, along (1, 0));
 
         driver crank_angle: angle(crank) = omega * t;
+
+        /// The piston stays on the liner's side of the crank pin.
+        branch piston_outboard: dot(bearing -> liner, rod @ (41.3, 0) -> rod @ (0, 102.6)) > 0;
+
+        gravity (0, -9810);
+    }
+}
+
+mechanism! {
+    /// Piston-crank of a boxer engine, free: the seed with the mass properties of
+    /// `piston_crank_dynamics.mech` (mm, kg, rad, s), each body's reference point at its centre of
+    /// mass, its crank not driven but released from rest at 0.3 rad and moving under gravity alone
+    /// (forward dynamics: the integrator sets the crank angle, rate and acceleration).
+    pub mechanism PistonCrankFree {
+        /// Cylinder liner (fixed).
+        ground liner at (156.8, 0, 0);
+        /// Piston, sliding in the liner.
+        body piston near (130, 0, 0) mass 0.5 inertia 300;
+        /// Connecting rod.
+        body rod near (29, 72, -2.35) mass 0.4 inertia 1500;
+        /// Crank shaft.
+        body crank near (0, 0, 0) mass 1.2 inertia 2000;
+        /// Crank bearing (fixed).
+        ground bearing at (0, 0, 0);
+
+        joint crank_pin: revolute(rod @ (41.3, 0), crank @ (0, 43));
+        joint piston_pin: revolute(piston @ (-28, 0), rod @ (0, 102.6));
+        joint main_bearing: revolute(crank, bearing);
+        joint slide: prismatic(liner, piston, along (1, 0));
+
+        /// The crank's degree of freedom, left to the equations of motion: at 0.3 rad and at rest
+        /// when released (its effort `crank_angle.effort` vanishes along the motion).
+        free crank_angle: angle(crank) from 0.3;
 
         /// The piston stays on the liner's side of the crank pin.
         branch piston_outboard: dot(bearing -> liner, rod @ (41.3, 0) -> rod @ (0, 102.6)) > 0;
