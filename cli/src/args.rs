@@ -11,6 +11,8 @@ use mechgen::syntax::limits::Limits;
 
 use crate::output::Format;
 
+pub mod simulate;
+
 /// Exit status text shared by every help page.
 const EXIT_STATUS: &str = "\
 FILE may be `-` to read the scene from standard input.
