@@ -2,6 +2,7 @@
 //! or one JSON document written as the run goes, each state with its scene's columns, then the
 //! columns a command adds after them (the energies of `simulate`).
 
+use core::fmt::Write as _;
 use std::io::{self, Write};
 
 use mechgen_interp::Interpreted;
@@ -166,10 +167,7 @@ impl Rows<'_> {
                 self.line.pop();
                 for value in extras.iter().copied().flatten() {
                     // As the state's own columns: shortest round trip, −0 written as 0.
-                    let _ = core::fmt::Write::write_fmt(
-                        &mut self.line,
-                        format_args!(",{:?}", value + 0.0),
-                    );
+                    let _ = write!(self.line, ",{:?}", value + 0.0);
                 }
                 if self.diagnostics {
                     let _ = write_diagnostics(state, &mut self.line);
@@ -251,7 +249,6 @@ fn positive_zeros(json: &str) -> String {
 
 /// `,iterations,substeps,evaluations,fallbacks,condition,det_sign` of a state.
 fn write_diagnostics(state: &State<Interpreted>, out: &mut String) -> core::fmt::Result {
-    use core::fmt::Write as _;
     write!(
         out,
         ",{},{},{},{},{:?},{}",
@@ -266,7 +263,97 @@ fn write_diagnostics(state: &State<Interpreted>, out: &mut String) -> core::fmt:
 
 #[cfg(test)]
 mod tests {
+    use mechgen_runtime::{Simulation, Solver};
+
     use super::*;
+
+    /// A driven arm at rest, assembled at t = 0.
+    fn arm() -> Simulation<Interpreted> {
+        let scene = mechgen::compile(
+            mechgen::Input::Text(
+                "mechanism Arm { ground g at (0, 0, 0); body b near (0, 0, 0);
+                 joint j: revolute(g, b); driver d: angle(b) = 0.5; }",
+            ),
+            &mechgen::Options::default(),
+        )
+        .expect("compiles");
+        Simulation::new(Solver::new(Interpreted::new(&scene)), 0.0).expect("assembles")
+    }
+
+    fn extras() -> [Extra; 2] {
+        let columns = |names: &[&str]| names.iter().map(|&n| n.to_owned()).collect();
+        [
+            Extra {
+                key: "energy",
+                columns: columns(&["energy.kinetic", "energy.total"]),
+            },
+            Extra {
+                key: "free",
+                columns: columns(&["swing.value"]),
+            },
+        ]
+    }
+
+    #[test]
+    fn extra_columns_follow_the_states_own_in_csv() {
+        let simulation = arm();
+        let m = simulation.solver().mechanism();
+        let layout = Layout::new(Format::Csv, false, m, &extras());
+        let mut out = Vec::new();
+        let mut rows = layout.start(&mut out).unwrap();
+        rows.row(simulation.state(), &[&[1.5, -0.0], &[0.25]])
+            .unwrap();
+        rows.finish(None, &[("stats", serde_json::json!({"steps": 3}))])
+            .unwrap();
+        let csv = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 2, "{csv}");
+        assert!(
+            lines[0].ends_with(",energy.kinetic,energy.total,swing.value"),
+            "{csv}"
+        );
+        assert!(lines[1].ends_with(",1.5,0.0,0.25"), "{csv}");
+        let (header, row) = (lines[0].split(',').count(), lines[1].split(',').count());
+        assert_eq!(header, row);
+    }
+
+    #[test]
+    fn extra_members_follow_the_states_own_in_json() {
+        let simulation = arm();
+        let m = simulation.solver().mechanism();
+        let layout = Layout::new(Format::Json, false, m, &extras());
+        let mut out = Vec::new();
+        let mut rows = layout.start(&mut out).unwrap();
+        for _ in 0..2 {
+            rows.row(simulation.state(), &[&[1.5, -0.0], &[0.25]])
+                .unwrap();
+        }
+        let stopped = Stopped {
+            step: 2,
+            kind: serde_json::json!("Kind"),
+            message: "stopped",
+        };
+        rows.finish(
+            Some(&stopped),
+            &[("stats", serde_json::json!({"steps": 3}))],
+        )
+        .unwrap();
+        let document: serde_json::Value = serde_json::from_slice(&out).unwrap();
+        assert_eq!(document["mechanism"], "Arm");
+        assert_eq!(
+            document["energy"],
+            serde_json::json!(["energy.kinetic", "energy.total"])
+        );
+        assert_eq!(document["free"], serde_json::json!(["swing.value"]));
+        let states = document["states"].as_array().unwrap();
+        assert_eq!(states.len(), 2);
+        assert_eq!(states[1]["energy"], serde_json::json!([1.5, 0.0]));
+        assert_eq!(states[1]["free"], serde_json::json!([0.25]));
+        assert_eq!(states[1]["q"], document["states"][0]["q"]);
+        assert_eq!(document["stats"]["steps"], 3);
+        assert_eq!(document["error"]["step"], 2);
+        assert_eq!(document["error"]["kind"], "Kind");
+    }
 
     #[test]
     fn negative_zeros_become_zeros_only_as_whole_numbers() {
