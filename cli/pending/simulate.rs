@@ -277,6 +277,11 @@ fn hint(error: &DynamicsError, start: bool) -> &'static str {
     match error {
         DynamicsError::Solve { error, .. } if start => assembly_hint(error),
         DynamicsError::Solve { error, .. } => motion_hint(error),
+        DynamicsError::Toggle { .. } => {
+            "the coordinates declared `free` pass a toggle here (a slider's travel at a crank's \
+             dead centre): declare free one that carries the mechanism through it, such as the \
+             crank's angle, or end the run before this time"
+        }
         DynamicsError::StepTooSmall { .. } => {
             "the error-controlled steps shrank below the smallest the integrator takes: the \
              motion changes too fast to follow here (a near-singular position, a very stiff \
