@@ -264,7 +264,7 @@ fn totals(stats: &IntegratorStats) -> serde_json::Value {
 /// What the run took, for the summary line.
 fn effort(stats: &IntegratorStats) -> String {
     format!(
-        "{} ({} rejected), {}, {}",
+        "{}, {} rejected, {}, {}",
         count(stats.steps, "integrator step"),
         stats.rejected,
         count(stats.iterations, "Newton iteration"),
