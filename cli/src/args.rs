@@ -9,7 +9,9 @@ use clap::{ArgGroup, Args, CommandFactory, Parser, Subcommand};
 
 use mechgen::syntax::limits::Limits;
 
-use crate::solve::Format;
+use crate::output::Format;
+
+pub mod simulate;
 
 /// Exit status text shared by every help page.
 const EXIT_STATUS: &str = "\
@@ -92,9 +94,11 @@ enum Sub {
     },
 }
 
+/// The flags `solve` and `simulate` share: the scene, the sample times, the parameter
+/// overrides and where and how the results are written.
 #[derive(Debug, Args)]
 #[command(group(ArgGroup::new("schedule").required(true).args(["t_end", "at", "times"])))]
-struct SolveFlags {
+struct RunFlags {
     /// The scene (a .mech file, or `-` for standard input)
     #[arg(value_name = "FILE")]
     file: PathBuf,
@@ -128,6 +132,12 @@ struct SolveFlags {
     /// Output format
     #[arg(long, value_enum, default_value_t = Format::Csv)]
     format: Format,
+}
+
+#[derive(Debug, Args)]
+struct SolveFlags {
+    #[command(flatten)]
+    run: RunFlags,
     /// Add per-step columns: Newton iterations, sub-steps, evaluations, static-pivot
     /// fallbacks, condition estimate and the sign of det Φ_q
     #[arg(long)]
@@ -208,9 +218,10 @@ pub enum Times {
     File(PathBuf),
 }
 
-/// Arguments of `mechgen solve`.
+/// What `solve` and `simulate` share: the scene, the sample times, the parameter overrides,
+/// and where and how the results are written.
 #[derive(Debug, Clone, PartialEq)]
-pub struct SolveArgs {
+pub struct RunArgs {
     /// The scene.
     pub input: Input,
     /// The limits it is read within.
@@ -224,6 +235,13 @@ pub struct SolveArgs {
     pub out: Output,
     /// CSV or JSON.
     pub format: Format,
+}
+
+/// Arguments of `mechgen solve`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolveArgs {
+    /// The scene, times, overrides and output.
+    pub run: RunArgs,
     /// Whether to add the per-step diagnostic columns.
     pub diagnostics: bool,
 }
@@ -260,7 +278,10 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<Command, clap::
             format,
         },
         Sub::Completions { shell } => Command::Completions(shell),
-        Sub::Solve(flags) => Command::Solve(solve_args(flags, limits)?),
+        Sub::Solve(flags) => Command::Solve(SolveArgs {
+            run: run_args(flags.run, limits, "solve")?,
+            diagnostics: flags.diagnostics,
+        }),
     })
 }
 
@@ -277,7 +298,9 @@ fn input(file: PathBuf) -> Input {
     }
 }
 
-fn solve_args(flags: SolveFlags, limits: Limits) -> Result<SolveArgs, clap::Error> {
+/// The shared flags checked and resolved; `command` names the subcommand in usage errors.
+fn run_args(flags: RunFlags, limits: Limits, command: &str) -> Result<RunArgs, clap::Error> {
+    let invalid = |message: String| usage_error(command, message);
     let times = match (flags.t_end, flags.steps, flags.times) {
         (Some(t_end), Some(steps), _) => {
             if t_end == flags.t0 {
@@ -325,27 +348,25 @@ fn solve_args(flags: SolveFlags, limits: Limits) -> Result<SolveArgs, clap::Erro
         }
         Some(path) => Output::File(path),
     };
-    Ok(SolveArgs {
+    Ok(RunArgs {
         input: input(flags.file),
         limits,
         times,
         sets: flags.sets,
         out,
         format: flags.format,
-        diagnostics: flags.diagnostics,
     })
 }
 
-/// A usage error of `mechgen solve` with clap's formatting (`Usage: mechgen solve …`, exit
+/// A usage error of `mechgen COMMAND` with clap's formatting (`Usage: mechgen solve …`, exit
 /// status 2).
-pub(crate) fn invalid(message: String) -> clap::Error {
-    let mut command = Cli::command();
+pub(crate) fn usage_error(command: &str, message: String) -> clap::Error {
+    let mut cli = Cli::command();
     // Building gives the subcommand its full name (`mechgen solve`) for the usage line.
-    command.build();
-    command
-        .find_subcommand("solve")
+    cli.build();
+    cli.find_subcommand(command)
         .cloned()
-        .unwrap_or(command)
+        .unwrap_or(cli)
         .error(clap::error::ErrorKind::ValueValidation, message)
 }
 
@@ -514,16 +535,18 @@ mod tests {
             "--diagnostics",
         ]);
         let expected = SolveArgs {
-            input: Input::File("s.mech".into()),
-            limits: Limits::default(),
-            times: Times::Equal {
-                t0: -0.5,
-                t_end: 0.5,
-                steps: 10,
+            run: RunArgs {
+                input: Input::File("s.mech".into()),
+                limits: Limits::default(),
+                times: Times::Equal {
+                    t0: -0.5,
+                    t_end: 0.5,
+                    steps: 10,
+                },
+                sets: vec![("omega".into(), 2.0), ("l".into(), 300.0)],
+                out: Output::File("out.csv".into()),
+                format: Format::Csv,
             },
-            sets: vec![("omega".into(), 2.0), ("l".into(), 300.0)],
-            out: Output::File("out.csv".into()),
-            format: Format::Csv,
             diagnostics: true,
         };
         assert_eq!(command.unwrap(), Command::Solve(expected));
@@ -539,7 +562,11 @@ mod tests {
             "--csv",
             "-",
         ];
-        let Ok(Command::Solve(args)) = parse_strs(&args) else {
+        let Ok(Command::Solve(SolveArgs {
+            run: args,
+            diagnostics,
+        })) = parse_strs(&args)
+        else {
             panic!("parses");
         };
         assert_eq!(
@@ -547,8 +574,10 @@ mod tests {
             Times::Listed(vec![-1.0, 0.1, 0.30000000000000004])
         );
         assert_eq!((args.input, args.out), (Input::Stdin, Output::Stdout));
-        assert!(!args.diagnostics);
-        let Ok(Command::Solve(args)) = parse_strs(&["solve", "s", "--times", "t.txt"]) else {
+        assert!(!diagnostics);
+        let Ok(Command::Solve(SolveArgs { run: args, .. })) =
+            parse_strs(&["solve", "s", "--times", "t.txt"])
+        else {
             panic!("parses");
         };
         assert_eq!(args.times, Times::File("t.txt".into()));
@@ -587,7 +616,7 @@ mod tests {
     #[test]
     fn times_and_values_are_constant_expressions() {
         let pi = core::f64::consts::PI;
-        let Ok(Command::Solve(args)) = parse_strs(&[
+        let Ok(Command::Solve(SolveArgs { run: args, .. })) = parse_strs(&[
             "solve",
             "s",
             "--t-end",
@@ -608,7 +637,7 @@ mod tests {
         };
         assert_eq!(args.times, expected);
         assert_eq!(args.sets, [("gamma".to_owned(), pi / 6.0)]);
-        let Ok(Command::Solve(args)) =
+        let Ok(Command::Solve(SolveArgs { run: args, .. })) =
             parse_strs(&["solve", "s", "--at", "0, atan2(1, 1),pi/2", "--at", "2"])
         else {
             panic!("parses");

@@ -1,4 +1,4 @@
-//! The sample times of `solve`: equal steps, or listed times (`--at`, a `--times` file).
+//! The sample times of a run: equal steps, or listed times (`--at`, a `--times` file).
 
 use std::path::Path;
 
@@ -33,6 +33,14 @@ impl Schedule {
         }
     }
 
+    /// The last time.
+    pub(crate) fn end(&self) -> f64 {
+        match self {
+            Schedule::Equal { t_end, .. } => *t_end,
+            Schedule::Listed(times) => times.last().copied().unwrap_or(0.0),
+        }
+    }
+
     /// The times stepped to after the start.
     pub(crate) fn after_start(&self) -> Box<dyn ExactSizeIterator<Item = f64> + '_> {
         match *self {
@@ -56,7 +64,7 @@ impl Schedule {
                 "{} from t = {} to {}",
                 count(times.len(), "listed time"),
                 args::time(self.start()),
-                args::time(times.last().copied().unwrap_or(0.0))
+                args::time(self.end())
             ),
         }
     }

@@ -1,8 +1,9 @@
 //! Counts and numbers as the command line writes them for people: `3 rows`, `1.4e-14`.
 
-/// `1 row`, `3 rows`.
-pub(crate) fn count(n: usize, noun: &str) -> String {
-    if n == 1 {
+/// `1 row`, `3 rows`, for a count of any integer type.
+pub(crate) fn count(n: impl core::fmt::Display, noun: &str) -> String {
+    let n = n.to_string();
+    if n == "1" {
         format!("1 {noun}")
     } else {
         format!("{n} {noun}s")

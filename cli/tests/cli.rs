@@ -1,38 +1,15 @@
 //! End-to-end tests of the `mechgen` binary: each command on the example scenes, error reports
 //! with positions, and bad command lines.
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
+use std::process::Command;
+
+use common::{csv_rows, mechgen, scene, scratch, text};
 use mechgen_runtime::{Simulation, Solver, sample_time};
 
 /// Positions of the seed at t = 0 from its closed form: piston x of the boxer piston-crank.
 const SEED_PISTON_X_AT_0: f64 = 129.89921491356055;
-
-fn scene(name: &str) -> String {
-    format!("{}/../examples/scenes/{name}", env!("CARGO_MANIFEST_DIR"))
-}
-
-fn mechgen(args: &[&str]) -> Output {
-    match Command::new(env!("CARGO_BIN_EXE_mechgen"))
-        .args(args)
-        .output()
-    {
-        Ok(output) => output,
-        Err(e) => panic!("cannot run mechgen: {e}"),
-    }
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
-/// A fresh path under Cargo's per-test scratch directory.
-fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("mechgen-cli-tests");
-    std::fs::create_dir_all(&dir).expect("scratch directory");
-    dir.join(name)
-}
 
 #[test]
 fn expand_prints_the_generated_mechanism() {
@@ -505,22 +482,6 @@ fn completions_are_printed_for_each_shell() {
         assert!(out.status.success(), "{shell}");
         assert!(text(&out.stdout).contains("solve"), "{shell}");
     }
-}
-
-/// The `t` column and the diagnostic columns of a `solve` run's CSV.
-fn csv_rows(out: &Output) -> (Vec<String>, Vec<Vec<String>>) {
-    let csv = text(&out.stdout);
-    let mut lines = csv.lines();
-    let header: Vec<String> = lines
-        .next()
-        .unwrap_or_default()
-        .split(',')
-        .map(str::to_owned)
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(str::to_owned).collect())
-        .collect();
-    (header, rows)
 }
 
 #[test]
