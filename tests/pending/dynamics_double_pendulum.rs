@@ -5,7 +5,7 @@
 
 mod dynamics;
 
-use dynamics::{adaptive, assert_constrained, interpreted, sample, start, times};
+use dynamics::{adaptive, assert_constrained, fixed, interpreted, sample, start, times};
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{Dynamic, EquationsOfMotion, FreeStorage, Storage, Structured};
 use mechgen_tests::reference::double_pendulum::{Bar, DoublePendulum as Reference};
@@ -65,7 +65,7 @@ where
         Tolerance::REFERENCE,
     )
     .unwrap_or_else(|e| panic!("{e}"));
-    let mut integrator = start(mechanism, adaptive(1e-10, 1e-12));
+    let mut integrator = start(mechanism, fixed(1e-4, 0.9));
     for k in 0..2 {
         let [u, rate, _] = integrator.free_state(k);
         assert_eq!(
@@ -94,20 +94,21 @@ where
         }
     }
     eprintln!(
-        "{label}: double pendulum, 1 s, rtol 1e-10: |θ − θ_ref| {angle:.1e} rad, |θ̇ − θ̇_ref| {rate:.1e} rad/s"
+        "{label}: double pendulum, 1 s, h = 1e-4: |θ − θ_ref| {angle:.1e} rad, |θ̇ − θ̇_ref| {rate:.1e} rad/s"
     );
     (angle, rate)
 }
 
 #[test]
 fn the_double_pendulum_follows_its_lagrange_equations() {
-    // Rates reach several rad/s: the bounds are 1e-5 of the motion's scale.
+    // Rates reach 10 rad/s. Generalized-α (ρ∞ = 0.9) on the reduced equations, emulated at
+    // h = 1e-4, is off by 3.6e-7 rad and 4.1e-6 rad/s.
     for (label, errors) in [
         ("generated", compare("generated", DoublePendulum::default())),
         ("interpreted", compare("interpreted", interpreted(DOUBLE))),
     ] {
-        assert!(errors.0 <= 1e-5, "{label}: angle {:e}", errors.0);
-        assert!(errors.1 <= 1e-4, "{label}: rate {:e}", errors.1);
+        assert!(errors.0 <= 1e-6, "{label}: angle {:e}", errors.0);
+        assert!(errors.1 <= 1.5e-5, "{label}: rate {:e}", errors.1);
     }
 }
 

@@ -10,7 +10,7 @@
 
 mod dynamics;
 
-use dynamics::{adaptive, fixed, sample, start, times};
+use dynamics::{fixed, sample, start, times};
 use mechgen_tests::reference::ode::{self, Tolerance};
 use mechgen_tests::reference::pendulum::Pendulum as Reference;
 use mechgen_tests::reference::seed::FreeSeed;
@@ -145,7 +145,10 @@ fn a_damped_seed_loses_what_its_damper_dissipates() {
     let scale = 0.4 * 9810.0 * 86.0;
     assert!(dissipated > 0.02 * scale, "{dissipated}");
 
-    let mut integrator = start(DampedSeed::default(), adaptive(1e-10, 1e-12));
+    // Bounds: generalized-α (ρ∞ = 0.9) on the reduced equation, emulated at this step with
+    // the trapezoidal quadrature of the damper's power, balances to 1.1e-7 and dissipates
+    // within 2.2e-8 of the reference.
+    let mut integrator = start(DampedSeed::default(), fixed(1e-4, 0.9));
     let total = integrator.energy().total();
     let mut previous = 0.0;
     for (s, y) in sample(&mut integrator, &at).iter().zip(&exact) {
@@ -158,9 +161,9 @@ fn a_damped_seed_loses_what_its_damper_dissipates() {
         previous = book.dissipated;
         let balance = (book.total() - total).abs() / scale;
         let lost = (book.dissipated - y[2]).abs() / dissipated;
-        assert!(balance <= 1e-7, "t = {}: balance off by {balance:e}", s.t);
+        assert!(balance <= 5e-7, "t = {}: balance off by {balance:e}", s.t);
         assert!(
-            lost <= 1e-5,
+            lost <= 1e-6,
             "t = {}: dissipated {} vs {}",
             s.t,
             book.dissipated,
@@ -170,20 +173,23 @@ fn a_damped_seed_loses_what_its_damper_dissipates() {
         assert_eq!([book.springs, book.loads_work, book.drivers_work], [0.0; 3]);
     }
     eprintln!(
-        "damped seed, 1 s, rtol 1e-10: dissipated {previous:.6e} vs reference {dissipated:.6e}"
+        "damped seed, 1 s, h = 1e-4: dissipated {previous:.6e} vs reference {dissipated:.6e}"
     );
 }
 
 #[test]
 fn a_driver_s_work_balances_the_book() {
-    let mut integrator = start(SwingOnACrank::default(), adaptive(1e-10, 1e-12));
+    // Bound: the reduced equation of the arm on its moving pivot, emulated with generalized-α
+    // (ρ∞ = 0.9) at this step and the trapezoidal quadrature of the driver's power, balances to
+    // 1.6e-7.
+    let mut integrator = start(SwingOnACrank::default(), fixed(1e-4, 0.9));
     let total = integrator.energy().total();
     // The arm's weight over the crank's and arm's lengths.
     let scale = 0.5 * 9810.0 * 140.0;
     let mut work = 0.0f64;
     for s in sample(&mut integrator, &times(1.0, 50)) {
         let balance = (s.energy.total() - total).abs() / scale;
-        assert!(balance <= 1e-7, "t = {}: balance off by {balance:e}", s.t);
+        assert!(balance <= 5e-7, "t = {}: balance off by {balance:e}", s.t);
         work = work.max(s.energy.drivers_work.abs());
     }
     // The driver does work on the swinging arm: the term is exercised.

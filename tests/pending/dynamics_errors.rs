@@ -111,7 +111,7 @@ fn a_step_below_the_minimum_is_a_typed_error() {
         ..IntegratorOptions::default()
     };
     let mut integrator = start(Weighted::default(), options);
-    let before = integrator.state().q.clone();
+    let before = integrator.state().q;
     match integrator.step() {
         Err(DynamicsError::StepTooSmall { t, step }) => {
             assert_eq!(t, 0.0);
@@ -169,7 +169,7 @@ fn a_load_that_turns_non_finite_stops_the_run_with_a_typed_error() {
     }
     let t = integrator.t();
     assert!((t - 0.9).abs() < 1e-12);
-    let q = integrator.state().q.clone();
+    let q = integrator.state().q;
     // The next step's end, t = 1.2, has sqrt(−0.2).
     match integrator.step() {
         Err(DynamicsError::NonFinite { t: at, .. }) | Err(DynamicsError::Solve { t: at, .. }) => {

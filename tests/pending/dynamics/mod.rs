@@ -7,10 +7,10 @@
 #![allow(dead_code)]
 
 use mechgen_interp::Interpreted;
-use mechgen_runtime::nalgebra::DefaultAllocator;
+use mechgen_runtime::nalgebra::{DefaultAllocator, Dim};
 use mechgen_runtime::{
-    Dynamic, Energy, EquationsOfMotion, FreeStorage, Integrator, IntegratorOptions, Matrix,
-    Mechanism, Solver, StepControl, Storage, Structured,
+    Dynamic, Energy, EquationsOfMotion, FreeStorage, Integrator, IntegratorOptions, Matrix, Solver,
+    StepControl, Storage, Structured,
 };
 
 /// A fixed step `step` with numerical damping `rho_inf`.
