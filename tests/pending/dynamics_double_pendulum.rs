@@ -1,7 +1,8 @@
 //! Forward dynamics of a double pendulum (two bars, two free angles) against its Lagrange
 //! equations in reduced coordinates written out by hand and integrated to about 1e-12
 //! (`mechgen_tests::reference::double_pendulum`), generated and interpreted alike: the free
-//! angles and rates, the centres of mass, and the constraints at every accepted step.
+//! angles and rates, the centres of mass, and the constraints at every accepted step; and
+//! its fixed steps against generalized-α written from the papers on the same equations.
 
 mod dynamics;
 
@@ -9,6 +10,7 @@ use dynamics::{adaptive, assert_constrained, fixed, interpreted, sample, start, 
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{Dynamic, EquationsOfMotion, FreeStorage, Storage, Structured};
 use mechgen_tests::reference::double_pendulum::{Bar, DoublePendulum as Reference};
+use mechgen_tests::reference::generalized_alpha::GeneralizedAlpha;
 use mechgen_tests::reference::ode::{self, Tolerance};
 use mechgen_tests::twin;
 
@@ -109,6 +111,38 @@ fn the_double_pendulum_follows_its_lagrange_equations() {
     ] {
         assert!(errors.0 <= 1e-6, "{label}: angle {:e}", errors.0);
         assert!(errors.1 <= 1.5e-5, "{label}: rate {:e}", errors.1);
+    }
+}
+
+#[test]
+fn fixed_steps_are_generalized_alpha_on_the_lagrange_equations() {
+    // Both free angles in one Newton iteration: the steps are those of
+    // `reference::generalized_alpha` on the two reduced equations, to the solvers' tolerances.
+    for rho_inf in [1.0, 0.6] {
+        let mut reduced = GeneralizedAlpha::new(
+            |_, u: &[f64; 2], v: &[f64; 2]| {
+                let r = REFERENCE.rate(&[u[0], u[1], v[0], v[1]]);
+                [r[2], r[3]]
+            },
+            0.0,
+            [-1.0, -0.6],
+            [0.0, 2.0],
+            rho_inf,
+        );
+        let mut integrator = start(DoublePendulum::default(), fixed(1e-3, rho_inf));
+        for n in 1..=300 {
+            integrator.step().unwrap_or_else(|e| panic!("{e}"));
+            reduced.step(1e-3).unwrap_or_else(|e| panic!("{e}"));
+            let [u, _, _] = reduced.state();
+            for k in 0..2 {
+                let got = integrator.free_state(k)[0];
+                assert!(
+                    (got - u[k]).abs() <= 1e-7,
+                    "ρ∞ = {rho_inf}, step {n}, free {k}: {got} vs {}",
+                    u[k]
+                );
+            }
+        }
     }
 }
 
