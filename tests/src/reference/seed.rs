@@ -154,17 +154,20 @@ impl FreeSeed {
 
     /// The crank's angular acceleration `φ̈` at `(φ, φ̇)`.
     pub fn acceleration(&self, phi: f64, rate: f64) -> f64 {
-        let c = self.configuration(phi);
-        let (m, dm) = self.generalised_mass(&c);
-        (self.generalised_force(&c, rate) - 0.5 * dm * rate * rate) / m
+        self.solve_acceleration(&self.configuration(phi), rate)
+    }
+
+    /// `φ̈` from the reduced equation at configuration `c` and rate `rate`.
+    fn solve_acceleration(&self, c: &Configuration, rate: f64) -> f64 {
+        let (m, dm) = self.generalised_mass(c);
+        (self.generalised_force(c, rate) - 0.5 * dm * rate * rate) / m
     }
 
     /// `[φ̇, φ̈, Ḋ]` at `[φ, φ̇, D]`, `D` the energy the damper has dissipated (`Ḋ = c ℓ̇²`).
     pub fn rate(&self, y: &[f64; 3]) -> [f64; 3] {
         let [phi, rate, _] = *y;
         let c = self.configuration(phi);
-        let (m, dm) = self.generalised_mass(&c);
-        let accel = (self.generalised_force(&c, rate) - 0.5 * dm * rate * rate) / m;
+        let accel = self.solve_acceleration(&c, rate);
         let (_, dlength) = self.spring_length(&c);
         let damping = self.spring.map_or(0.0, |s| s.damping);
         [rate, accel, damping * (dlength * rate).powi(2)]
@@ -181,7 +184,7 @@ impl FreeSeed {
     /// `q̈ = q′ φ̈ + q″ φ̇²`.
     pub fn motion(&self, phi: f64, rate: f64) -> [[f64; 15]; 3] {
         let c = self.configuration(phi);
-        let accel = self.acceleration(phi, rate);
+        let accel = self.solve_acceleration(&c, rate);
         [
             c.q,
             c.dq.map(|d| d * rate),
