@@ -3,7 +3,7 @@
 //! kinematics in closed form, integrated to about 1e-12 (`mechgen_tests::reference::seed`):
 //!
 //! - the crank angle and speed and every coordinate, generated, interpreted and the example
-//!   scene `examples/scenes/piston_crank_free.mech`;
+//!   scene `examples/scenes/piston_crank_free.mech` with its twin `PistonCrankFree`;
 //! - the order of convergence of the fixed-step mode (ρ∞ = 1 and 0.5), and its steps against
 //!   generalized-α written from the papers on the reduced equation;
 //! - the reactions along the motion against the closed-form Newton–Euler elimination of the
@@ -20,6 +20,7 @@ use dynamics::{
 };
 use mechgen_examples::closed_form::Kinematics;
 use mechgen_examples::inverse_dynamics::seed_reactions;
+use mechgen_examples::scenes::PistonCrankFree;
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{
     Dynamic, EquationsOfMotion, FreeStorage, IntegratorOptions, Storage, Structured,
@@ -112,6 +113,11 @@ fn the_free_seed_follows_its_reduced_lagrange_equation() {
         (
             "interpreted, h = 1e-4",
             errors(interpreted(FREE_SEED), fixed(1e-4, 0.9), &at),
+            [5e-7, 3e-7, 5e-5, 3e-7],
+        ),
+        (
+            "PistonCrankFree (the example's twin), h = 1e-4",
+            errors(PistonCrankFree::default(), fixed(1e-4, 0.9), &at),
             [5e-7, 3e-7, 5e-5, 3e-7],
         ),
         (
