@@ -1,8 +1,10 @@
 //! Cross-crate integration tests live in `tests/`. This library compiles the README's examples
 //! as doctests, so the front page cannot drift from the code, and holds the fuzzing harness the
-//! CI test and the `cargo fuzz` targets share.
+//! CI test and the `cargo fuzz` targets share, and the reference solutions of the
+//! forward-dynamics tests (`reference`).
 
 pub mod fuzzing;
+pub mod reference;
 
 /// A scene both as generated code (`mechanism! { … }`) and as `.mech` text for the interpreter
 /// (`const $text: &str`), from one source: `twin! { TEXT, mechanism Name { … } }`.

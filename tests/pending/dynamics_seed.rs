@@ -1,0 +1,351 @@
+//! The free seed (the piston-crank with its mass properties, the crank free, released from rest
+//! at 0.3 rad under gravity) against its reduced one-coordinate Lagrange equation, the
+//! kinematics in closed form, integrated to about 1e-12 (`mechgen_tests::reference::seed`):
+//!
+//! - the crank angle and speed and every coordinate, generated, interpreted and the example
+//!   scene `examples/scenes/piston_crank_free.mech` with its twin `PistonCrankFree`;
+//! - the order of convergence of the fixed-step mode (ρ∞ = 1 and 0.5), and its steps against
+//!   generalized-α written from the papers on the reduced equation;
+//! - the reactions along the motion against the closed-form Newton–Euler elimination of the
+//!   seed (`mechgen_examples::inverse_dynamics`), the free crank's effort zero;
+//! - the constraints at every accepted step; generated and interpreted stepping alike;
+//! - property tests over random initial states `(u₀, u̇₀)`: the reference, the energy balance
+//!   and the constraints.
+
+mod dynamics;
+
+use dynamics::{
+    adaptive, assert_constrained, constraint_residuals, fixed, interpreted, sample, start, times,
+    worst,
+};
+use mechgen_examples::closed_form::Kinematics;
+use mechgen_examples::inverse_dynamics::seed_reactions;
+use mechgen_examples::scenes::PistonCrankFree;
+use mechgen_runtime::nalgebra::DefaultAllocator;
+use mechgen_runtime::{
+    Dynamic, EquationsOfMotion, FreeStorage, IntegratorOptions, Storage, Structured,
+};
+use mechgen_tests::example_scene;
+use mechgen_tests::reference::generalized_alpha::GeneralizedAlpha;
+use mechgen_tests::reference::ode::{self, Tolerance};
+use mechgen_tests::reference::seed::FreeSeed as Reference;
+use mechgen_tests::twin;
+use proptest::prelude::*;
+
+twin! {
+    FREE_SEED,
+    mechanism FreeSeed {
+        /// Release angle and speed of the crank (rad, rad/s).
+        param start = 0.3;
+        param spin = 0.0;
+
+        ground liner at (156.8, 0, 0);
+        body piston near (130, 0, 0) mass 0.5 inertia 300;
+        body rod near (29, 72, -2.35) mass 0.4 inertia 1500;
+        body crank near (0, 0, 0) mass 1.2 inertia 2000;
+        ground bearing at (0, 0, 0);
+
+        joint crank_pin: revolute(rod @ (41.3, 0), crank @ (0, 43));
+        joint piston_pin: revolute(piston @ (-28, 0), rod @ (0, 102.6));
+        joint main_bearing: revolute(crank, bearing);
+        joint slide: prismatic(liner, piston, along (1, 0));
+
+        free crank_angle: angle(crank) from start speed spin;
+
+        branch piston_outboard: dot(bearing -> liner, rod @ (41.3, 0) -> rod @ (0, 102.6)) > 0;
+
+        gravity (0, -9810);
+    }
+}
+
+/// The crank's angle in `q`.
+const CRANK_THETA: usize = 11;
+
+/// The reference `[φ, φ̇, D]` at `at` from `(φ₀, φ̇₀)`.
+fn reference(seed: &Reference, phi0: f64, rate0: f64, at: &[f64]) -> Vec<[f64; 3]> {
+    ode::sample(
+        |_, y| seed.rate(y),
+        0.0,
+        [phi0, rate0, 0.0],
+        at,
+        Tolerance::REFERENCE,
+    )
+    .unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Largest errors of a release of `mechanism` against the reference over `at`: crank angle
+/// (rad), crank speed relative to its largest, every coordinate (mm, rad) and every velocity
+/// relative to the largest.
+fn errors<M>(mechanism: M, options: IntegratorOptions, at: &[f64]) -> [f64; 4]
+where
+    M: Dynamic + EquationsOfMotion + Structured,
+    DefaultAllocator: Storage<M::Dim> + FreeStorage<M::Dim, M::Free>,
+{
+    let seed = Reference::default();
+    let exact = reference(&seed, Reference::RELEASE, 0.0, at);
+    let top = exact.iter().map(|y| y[1].abs()).fold(0.0, f64::max);
+    let mut integrator = start(mechanism, options);
+    let mut e = [0.0f64; 4];
+    for (s, y) in sample(&mut integrator, at).iter().zip(&exact) {
+        let [q, qd, _] = seed.motion(y[0], y[1]);
+        let [u, rate, _] = s.free[0];
+        e[0] = e[0].max((u - y[0]).abs());
+        e[1] = e[1].max((rate - y[1]).abs() / top);
+        e[2] = e[2].max(worst(&s.q, &q));
+        e[3] = e[3].max(worst(&s.qd, &qd) / (top * 120.0));
+    }
+    e
+}
+
+#[test]
+fn the_free_seed_follows_its_reduced_lagrange_equation() {
+    // The crank swings 2.6 rad at up to 13.2 rad/s in this time. Bounds of the fixed step:
+    // generalized-α (ρ∞ = 0.9) on the reduced equation, emulated at h = 1e-4, is off by
+    // 1.3e-7 rad and 7.8e-8 of the top speed. The error-controlled mode is held to the
+    // tolerance's scale: its step sequence is the implementation's.
+    let at = times(0.5, 50);
+    for (label, e, bounds) in [
+        (
+            "generated, h = 1e-4",
+            errors(FreeSeed::default(), fixed(1e-4, 0.9), &at),
+            [5e-7, 3e-7, 5e-5, 3e-7],
+        ),
+        (
+            "interpreted, h = 1e-4",
+            errors(interpreted(FREE_SEED), fixed(1e-4, 0.9), &at),
+            [5e-7, 3e-7, 5e-5, 3e-7],
+        ),
+        (
+            "PistonCrankFree (the example's twin), h = 1e-4",
+            errors(PistonCrankFree::default(), fixed(1e-4, 0.9), &at),
+            [5e-7, 3e-7, 5e-5, 3e-7],
+        ),
+        (
+            "piston_crank_free.mech, h = 1e-4",
+            errors(
+                example_scene("piston_crank_free.mech"),
+                fixed(1e-4, 0.9),
+                &at,
+            ),
+            [5e-7, 3e-7, 5e-5, 3e-7],
+        ),
+        (
+            "generated, rtol 1e-10",
+            errors(FreeSeed::default(), adaptive(1e-10, 1e-12), &at),
+            [1e-5, 1e-5, 1e-3, 1e-5],
+        ),
+        (
+            "interpreted, rtol 1e-10",
+            errors(interpreted(FREE_SEED), adaptive(1e-10, 1e-12), &at),
+            [1e-5, 1e-5, 1e-3, 1e-5],
+        ),
+    ] {
+        eprintln!(
+            "{label}: free seed 0.5 s: φ {:.1e} rad, φ̇ {:.1e} (relative), q {:.1e}, \
+             q̇ {:.1e} (relative)",
+            e[0], e[1], e[2], e[3]
+        );
+        for (what, (error, bound)) in ["φ", "φ̇", "q", "q̇"].iter().zip(e.iter().zip(bounds)) {
+            assert!(*error <= bound, "{label}: {what} off by {error:e}");
+        }
+    }
+}
+
+#[test]
+fn halving_the_step_quarters_the_error_of_the_seed() {
+    let t_end = 0.2;
+    let exact = reference(&Reference::default(), Reference::RELEASE, 0.0, &[t_end])[0];
+    for rho_inf in [1.0, 0.5] {
+        let e: Vec<f64> = [100, 200, 400, 800]
+            .iter()
+            .map(|&n| {
+                let mut integrator = start(FreeSeed::default(), fixed(t_end / n as f64, rho_inf));
+                integrator.step_to(t_end).unwrap_or_else(|e| panic!("{e}"));
+                (integrator.free_state(0)[0] - exact[0]).abs()
+            })
+            .collect();
+        let ratios: Vec<f64> = e.windows(2).map(|w| w[0] / w[1]).collect();
+        eprintln!("free seed, ρ∞ = {rho_inf}: errors {e:?}, ratios {ratios:?}");
+        for r in &ratios {
+            assert!((3.4..=4.6).contains(r), "ρ∞ = {rho_inf}: ratios {ratios:?}");
+        }
+    }
+}
+
+#[test]
+fn fixed_steps_are_generalized_alpha_on_the_reduced_equation() {
+    // Coordinate partitioning: the integrator is generalized-α on the reduced equation, so its
+    // fixed steps are those of `reference::generalized_alpha` on the reference's equation, to
+    // the Newton and kinematic tolerances (100 times below the method's own error here).
+    let seed = Reference::default();
+    for rho_inf in [1.0, 0.5, 0.0] {
+        let mut reduced = GeneralizedAlpha::new(
+            |_, u: &[f64; 1], v: &[f64; 1]| [seed.acceleration(u[0], v[0])],
+            0.0,
+            [Reference::RELEASE],
+            [0.0],
+            rho_inf,
+        );
+        let mut integrator = start(FreeSeed::default(), fixed(1e-3, rho_inf));
+        for n in 1..=200 {
+            integrator.step().unwrap_or_else(|e| panic!("{e}"));
+            reduced.step(1e-3).unwrap_or_else(|e| panic!("{e}"));
+            let [u, rate, _] = integrator.free_state(0);
+            let [v, vd, _] = reduced.state();
+            assert!(
+                (u - v[0]).abs() <= 1e-7 && (rate - vd[0]).abs() <= 1e-6 * (1.0 + vd[0].abs()),
+                "ρ∞ = {rho_inf}, step {n}: ({u}, {rate}) vs ({}, {})",
+                v[0],
+                vd[0]
+            );
+        }
+    }
+}
+
+#[test]
+fn reactions_are_the_newton_euler_ones_and_the_free_crank_needs_no_torque() {
+    let seed = Reference::default();
+    let mut integrator = start(FreeSeed::default(), adaptive(1e-9, 1e-12));
+    // The free crank's equation is where the driver's was: the reference's last row.
+    assert_eq!(integrator.solver().mechanism().free_equation(0), 14);
+    // The scale of the forces: the weight of the moving parts at the crank's radius.
+    let torque_scale = 2.1 * 9810.0 * 43.0;
+    let force_scale = 2.1 * 9810.0;
+    for &t in &times(0.5, 25) {
+        integrator.step_to(t).unwrap_or_else(|e| panic!("{e}"));
+        let state = integrator.state();
+        let slice = |v: &[f64]| -> [f64; 15] { v.try_into().expect("15 coordinates") };
+        let k = Kinematics {
+            t,
+            q: slice(state.q.as_slice()),
+            qd: slice(state.qd().as_slice()),
+            qdd: slice(state.qdd().as_slice()),
+        };
+        let exact = seed_reactions(&seed.geometry, &seed.mass, &k).in_equation_order();
+        let solved = integrator
+            .constraint_forces()
+            .unwrap_or_else(|e| panic!("{e}"))
+            .as_slice()
+            .to_vec();
+        // Row 14 is the free crank's: its effort is the residual of the equation of motion.
+        assert!(
+            solved[14].abs() <= 1e-6 * torque_scale,
+            "t = {t}: effort {}",
+            solved[14]
+        );
+        assert!(
+            exact[14].abs() <= 1e-6 * torque_scale,
+            "t = {t}: torque {}",
+            exact[14]
+        );
+        let error = worst(&solved[..14], &exact[..14]);
+        assert!(
+            error <= 1e-8 * force_scale * 100.0,
+            "t = {t}: reactions off by {error:e}"
+        );
+    }
+}
+
+#[test]
+fn every_accepted_step_satisfies_the_constraints() {
+    for options in [adaptive(1e-6, 1e-9), fixed(1e-3, 0.5), fixed(1e-2, 0.0)] {
+        let mut integrator = start(FreeSeed::default(), options);
+        assert_constrained(&integrator, &[CRANK_THETA]);
+        let mut steps = 0;
+        while integrator.t() < 0.5 {
+            integrator.step().unwrap_or_else(|e| panic!("{e}"));
+            assert_constrained(&integrator, &[CRANK_THETA]);
+            steps += 1;
+        }
+        assert_eq!(integrator.stats().steps, steps);
+    }
+}
+
+#[test]
+fn generated_and_interpreted_step_alike() {
+    let mut generated = start(FreeSeed::default(), fixed(1e-3, 0.8));
+    let mut twin = start(interpreted(FREE_SEED), fixed(1e-3, 0.8));
+    for &t in &times(0.5, 50) {
+        let a = generated
+            .step_to(t)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .q
+            .as_slice()
+            .to_vec();
+        let b = twin
+            .step_to(t)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .q
+            .as_slice()
+            .to_vec();
+        // libm against std elementary functions: round-off, through a Newton iteration.
+        assert!(worst(&a, &b) <= 1e-9, "t = {t}: {:e}", worst(&a, &b));
+        let (ea, eb) = (generated.energy(), twin.energy());
+        assert!((ea.total() - eb.total()).abs() <= 1e-9 * ea.kinetic.abs().max(1e5));
+    }
+    assert_eq!(generated.stats().steps, twin.stats().steps);
+}
+
+#[test]
+fn set_free_restarts_from_the_new_state() {
+    let seed = Reference::default();
+    let mut integrator = start(FreeSeed::default(), fixed(1e-4, 0.9));
+    integrator.step_to(0.1).unwrap_or_else(|e| panic!("{e}"));
+    integrator
+        .set_free(0, 1.0, -4.0)
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(integrator.t(), 0.1);
+    let [u, rate, accel] = integrator.free_state(0);
+    assert_eq!([u, rate], [1.0, -4.0]);
+    // The new accelerations are solved at once: the reference's φ̈ there.
+    let expected = seed.acceleration(1.0, -4.0);
+    assert!(
+        (accel - expected).abs() <= 1e-8 * expected.abs().max(1.0),
+        "{accel} vs {expected}"
+    );
+    assert_constrained(&integrator, &[CRANK_THETA]);
+    let exact = reference(&seed, 1.0, -4.0, &[0.1])[0];
+    integrator.step_to(0.2).unwrap_or_else(|e| panic!("{e}"));
+    assert!((integrator.free_state(0)[0] - exact[0]).abs() <= 1e-6);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+
+    /// Any release: the reference, the energy book's balance and the constraints.
+    #[test]
+    fn any_release_follows_the_reference_and_keeps_its_energy(
+        phi0 in -1.5..1.5f64,
+        rate0 in -40.0..40.0f64,
+    ) {
+        let seed = Reference::default();
+        let mechanism = FreeSeed {
+            start: phi0,
+            spin: rate0,
+            ..FreeSeed::default()
+        };
+        // Bounds: generalized-α (ρ∞ = 0.9) on the reduced equation, emulated at this step over
+        // a grid of these releases, drifts by 3.2e-6 of the scale below and ends within
+        // 3.5e-6 rad and 1.1e-6 (relative) of the reference.
+        let mut integrator = start(mechanism, fixed(1e-4, 0.9));
+        let [u, rate, _] = integrator.free_state(0);
+        prop_assert_eq!([u, rate], [phi0, rate0]);
+        let total = integrator.energy().total();
+        // The energies exchanged: the kinetic energy of the release and the potential's range.
+        let scale = seed.energy(&[phi0, rate0, 0.0]) - seed.energy(&[phi0, 0.0, 0.0])
+            + 0.4 * 9810.0 * 86.0;
+        while integrator.t() < 0.1 {
+            integrator.step().unwrap_or_else(|e| panic!("{e}"));
+            let [position, velocity, free] = constraint_residuals(&integrator, &[CRANK_THETA]);
+            prop_assert!(position <= 1e-8 && velocity <= 1e-12 && free <= 1e-9);
+            let drift = (integrator.energy().total() - total).abs() / scale;
+            prop_assert!(drift <= 1e-5, "t = {}: energy drift {:e}", integrator.t(), drift);
+        }
+        // Wherever the last step ended, the reference there.
+        let t = integrator.t();
+        let exact = reference(&seed, phi0, rate0, &[t])[0];
+        let [u, rate, _] = integrator.free_state(0);
+        prop_assert!((u - exact[0]).abs() <= 1e-5, "φ {} vs {}", u, exact[0]);
+        prop_assert!((rate - exact[1]).abs() <= 5e-6 * (1.0 + exact[1].abs()));
+    }
+}
