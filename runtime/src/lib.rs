@@ -73,6 +73,7 @@ mod error;
 mod finite;
 mod forces;
 mod geometry;
+mod integrator;
 mod lu;
 mod markers;
 mod mechanism;
@@ -93,6 +94,10 @@ pub use dense::Dense;
 pub use dynamic::{Dynamic, EnergyTerms, EquationsOfMotion, FreeStorage};
 pub use error::{Described, Quantity, SolveError};
 pub use geometry::{GeometryFault, MAX_LENGTH, Requirement};
+pub use integrator::{
+    DescribedDynamics, DynamicsError, Energy, Integrator, IntegratorOptions, IntegratorStats,
+    StepControl,
+};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use markers::{
     AnglePosition, AngleState, AngleVelocity, PointPosition, PointState, PointVelocity,

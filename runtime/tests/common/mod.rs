@@ -1,8 +1,12 @@
 //! Hand-written mechanisms with closed-form motion, which the integration tests solve through
 //! the runtime's public API: a driven pendulum (the smallest scene, with forces) and a
-//! slider-crank.
+//! slider-crank; and scenes with free degrees of freedom for the integrator (a pendulum, two
+//! sliders on springs), presented through `Scene`.
 // Not every test binary uses every fixture.
 #![allow(dead_code)]
 
+pub mod free_pendulum;
 pub mod pendulum;
+pub mod scene;
 pub mod slider_crank;
+pub mod sliders;

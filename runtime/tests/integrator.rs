@@ -1,0 +1,490 @@
+//! The forward-dynamics integrator against independent references: the pendulum's
+//! one-coordinate Lagrange equation integrated by RK4 with tiny steps in the test, its
+//! small-amplitude harmonic solution and its large-amplitude period from the complete elliptic
+//! integral (by the arithmetic–geometric mean), and the modal solution of two sliders on
+//! springs (the stiff case); plus the constraint residuals, the force solve of the produced
+//! motion, the energy balance, and the typed errors.
+
+mod common;
+
+use common::free_pendulum::FreePendulum;
+use common::scene::Scene;
+use common::sliders::Sliders;
+use core::f64::consts::{FRAC_PI_2, PI};
+use mechgen_runtime::{
+    DynamicsError, Integrator, IntegratorOptions, Mechanism, Solver, StepControl, Vector,
+};
+
+type Pendulum = Integrator<Scene<FreePendulum>>;
+
+fn fixed(rho_inf: f64, step: f64) -> IntegratorOptions {
+    IntegratorOptions {
+        rho_inf,
+        control: StepControl::Fixed { step },
+        ..IntegratorOptions::default()
+    }
+}
+
+fn adaptive(rho_inf: f64, rtol: f64, atol: f64) -> IntegratorOptions {
+    IntegratorOptions {
+        rho_inf,
+        control: StepControl::Adaptive {
+            rtol,
+            atol,
+            initial: 1e-3,
+            min: 1e-12,
+            max: f64::INFINITY,
+        },
+        ..IntegratorOptions::default()
+    }
+}
+
+fn pendulum(p: FreePendulum, options: IntegratorOptions) -> Pendulum {
+    match Integrator::new(Solver::new(Scene::new(p)), 0.0, options) {
+        Ok(integrator) => integrator,
+        Err(error) => panic!("{error}"),
+    }
+}
+
+/// `(θ, θ̇)` at `t` from the pendulum's Lagrange equation, by classical RK4 with steps of at
+/// most 1e-4 s (error ~1e-15 over a few seconds).
+fn reference(p: &FreePendulum, theta0: f64, rate0: f64, t: f64) -> (f64, f64) {
+    let n = (t / 1e-4).ceil().max(1.0) as usize;
+    let h = t / n as f64;
+    let f = |y: [f64; 2]| [y[1], p.theta_ddot(y[0], y[1])];
+    let mut y = [theta0, rate0];
+    for _ in 0..n {
+        let k1 = f(y);
+        let k2 = f([y[0] + 0.5 * h * k1[0], y[1] + 0.5 * h * k1[1]]);
+        let k3 = f([y[0] + 0.5 * h * k2[0], y[1] + 0.5 * h * k2[1]]);
+        let k4 = f([y[0] + h * k3[0], y[1] + h * k3[1]]);
+        for i in 0..2 {
+            y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
+    }
+    (y[0], y[1])
+}
+
+/// The position and velocity constraint residuals of the pendulum's state, each row in its
+/// unit (lengths relative to the rod), the free row against the integrator's free state.
+fn residuals(integrator: &Pendulum) -> (f64, f64) {
+    let p = integrator.solver().mechanism().inner();
+    let state = integrator.state();
+    let (q, qd) = (&state.q, state.qd());
+    let [u, ud, _] = integrator.free_state(0);
+    let l = p.length;
+    let (s, c) = (q.z.sin(), q.z.cos());
+    let position = [(q.x - l * c) / l, (q.y - l * s) / l, q.z - u];
+    let velocity = [
+        (qd.x + l * s * qd.z) / l,
+        (qd.y - l * c * qd.z) / l,
+        qd.z - ud,
+    ];
+    let max = |v: [f64; 3]| v.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+    (max(position), max(velocity))
+}
+
+/// The largest error in θ and θ̇ over the samples t = 0.1, 0.2, …, `t_end` of a fixed-step run
+/// released from rest at `theta0`.
+fn fixed_step_error(rho: f64, h: f64, theta0: f64, t_end: f64) -> (f64, f64) {
+    let p = FreePendulum::released(theta0, 0.0);
+    let samples = (t_end / 0.1).round() as usize;
+    let exact: Vec<(f64, f64)> = (1..=samples)
+        .map(|k| reference(&p, theta0, 0.0, 0.1 * k as f64))
+        .collect();
+    let mut integrator = pendulum(p, fixed(rho, h));
+    let (mut position, mut velocity) = (0.0_f64, 0.0_f64);
+    for (k, (theta, rate)) in exact.into_iter().enumerate() {
+        let t = 0.1 * (k + 1) as f64;
+        integrator.step_to(t).unwrap();
+        assert_eq!(integrator.t(), t);
+        let [u, ud, _] = integrator.free_state(0);
+        position = position.max((u - theta).abs());
+        velocity = velocity.max((ud - rate).abs());
+    }
+    (position, velocity)
+}
+
+#[test]
+fn halving_the_step_divides_the_error_by_four_for_every_rho() {
+    let theta0 = -FRAC_PI_2 + 1.0;
+    for rho in [1.0, 0.8, 0.5, 0.0] {
+        let errors: Vec<(f64, f64)> = [0.02, 0.01, 0.005]
+            .iter()
+            .map(|&h| fixed_step_error(rho, h, theta0, 2.0))
+            .collect();
+        eprintln!("ρ∞ = {rho}: largest errors (θ, θ̇) at h = 0.02, 0.01, 0.005: {errors:?}");
+        for pair in errors.windows(2) {
+            let (position, velocity) = (pair[0].0 / pair[1].0, pair[0].1 / pair[1].1);
+            eprintln!("ρ∞ = {rho}: ratios {position:.3} {velocity:.3}");
+            assert!(
+                (3.5..4.6).contains(&position),
+                "ρ∞ = {rho}: θ ratio {position}"
+            );
+            assert!(
+                (3.5..4.6).contains(&velocity),
+                "ρ∞ = {rho}: θ̇ ratio {velocity}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_small_swing_follows_the_harmonic_solution() {
+    let amplitude = 1e-3;
+    let p = FreePendulum::released(-FRAC_PI_2 + amplitude, 0.0);
+    let w = p.omega();
+    let mut integrator = pendulum(p, adaptive(0.9, 1e-9, 1e-12));
+    for k in 1..=40 {
+        let t = 0.05 * k as f64;
+        integrator.step_to(t).unwrap();
+        let phi = integrator.free_state(0)[0] + FRAC_PI_2;
+        let harmonic = amplitude * (w * t).cos();
+        // The nonlinearity shifts the frequency by a relative φ0²/16 ≈ 6e-8.
+        assert!(
+            (phi - harmonic).abs() < 1e-3 * amplitude,
+            "t = {t}: {phi} vs {harmonic}"
+        );
+    }
+}
+
+/// K(k) = π / (2 AGM(1, √(1 − k²))).
+fn elliptic_k(k: f64) -> f64 {
+    let (mut a, mut b) = (1.0_f64, (1.0 - k * k).sqrt());
+    while (a - b).abs() > 1e-16 * a {
+        (a, b) = (0.5 * (a + b), (a * b).sqrt());
+    }
+    PI / (2.0 * a)
+}
+
+#[test]
+fn a_large_swing_returns_after_the_elliptic_period() {
+    let amplitude = 2.5;
+    let p = FreePendulum::released(-FRAC_PI_2 + amplitude, 0.0);
+    let period = 4.0 * elliptic_k((0.5 * amplitude).sin()) / p.omega();
+    let mut integrator = pendulum(p, adaptive(0.9, 1e-9, 1e-12));
+    integrator.step_to(period).unwrap();
+    let [u, ud, _] = integrator.free_state(0);
+    eprintln!(
+        "period {period}: φ − φ0 = {:e}, φ̇ = {ud:e}, {:?}",
+        u + FRAC_PI_2 - amplitude,
+        integrator.stats()
+    );
+    assert!((u + FRAC_PI_2 - amplitude).abs() < 1e-5);
+    assert!(ud.abs() < 1e-4);
+    // Half a period later it is at the other extreme.
+    integrator.step_to(1.5 * period).unwrap();
+    let [u, ud, _] = integrator.free_state(0);
+    assert!((u + FRAC_PI_2 + amplitude).abs() < 1e-5);
+    assert!(ud.abs() < 1e-4);
+}
+
+#[test]
+fn constraints_hold_at_every_accepted_step() {
+    for options in [fixed(0.7, 0.01), adaptive(0.9, 1e-6, 1e-9)] {
+        let mut integrator = pendulum(FreePendulum::released(0.4, 2.0), options);
+        let (mut position, mut velocity) = (0.0_f64, 0.0_f64);
+        for _ in 0..300 {
+            integrator.step().unwrap();
+            let (p, v) = residuals(&integrator);
+            position = position.max(p);
+            velocity = velocity.max(v);
+        }
+        eprintln!("largest residuals: |Φ| {position:e}, |Φ_q q̇ − ν| {velocity:e}");
+        // The solver's acceptance tolerance (scaled) is 1e-8; Newton lands far below it.
+        assert!(position < 1e-8, "{position}");
+        assert!(velocity < 1e-13, "{velocity}");
+    }
+}
+
+/// The reactions after a step are the force solve of the state's motion, and they match the
+/// reference: the pin carries `m (a − g)` with the centre's acceleration from the reference
+/// equation's θ, θ̇, θ̈; the free degree of freedom's effort vanishes.
+#[test]
+fn reactions_are_the_force_solve_of_the_motion() {
+    let p = FreePendulum::released(-0.3, 1.0);
+    let mut integrator = pendulum(p.clone(), fixed(0.9, 1e-3));
+    integrator.step_to(0.4).unwrap();
+    let (theta, rate) = reference(&p, -0.3, 1.0, 0.4);
+    let theta_ddot = p.theta_ddot(theta, rate);
+    let (l, m, g) = (p.length, p.mass, p.gravity);
+    let (s, c) = (theta.sin(), theta.cos());
+    let ax = -l * s * theta_ddot - l * c * rate * rate;
+    let ay = l * c * theta_ddot - l * s * rate * rate;
+    // The pin's force on the bob, from Newton's law on the centre.
+    let pin = [m * ax, m * (ay + g)];
+    let state = integrator.state().clone();
+    let [u, ud, udd] = integrator.free_state(0);
+    let reactions = *integrator.constraint_forces().unwrap();
+    // Φ_qᵀ λ = F with F = Q − M q̈: the pin's multipliers are minus its force on the bob.
+    assert!(
+        (reactions[0] + pin[0]).abs() < 1e-5 * m * g,
+        "{reactions:?} vs {pin:?}"
+    );
+    assert!(
+        (reactions[1] + pin[1]).abs() < 1e-5 * m * g,
+        "{reactions:?} vs {pin:?}"
+    );
+    assert!(
+        reactions[2].abs() < 1e-8 * m * g * l,
+        "effort {}",
+        reactions[2]
+    );
+    // A fresh solver at the same free state and time gives the same force solve.
+    let mut same = p.clone();
+    same.free = [u, ud, udd];
+    let mut solver = Solver::new(Scene::new(same));
+    let fresh = solver.solve(state.t, &state.q).unwrap();
+    let difference = (fresh.constraint_forces() - reactions).amax();
+    assert!(difference < 1e-9 * m * g, "{difference}");
+}
+
+/// Two sliders: the slow mode resolved by the step, the fast one (from a spring k2) with a
+/// period 1000× shorter than it.
+fn stiff_sliders(h: f64, excite: f64) -> (Sliders, [f64; 2], f64) {
+    let masses = [1.0, 1.0];
+    let k1 = 2.0 * (2.0 * PI).powi(2);
+    let fast = 2.0 * PI * 1000.0 / h;
+    let k2 = 0.5 * fast * fast;
+    // Modes: det(K − ω² M) = 0 with K = [[k1 + k2, −k2], [−k2, k2]], M = I.
+    let trace = k1 + 2.0 * k2;
+    let det = k1 * k2;
+    let slow2 = 0.5 * (trace - (trace * trace - 4.0 * det).sqrt());
+    // Slow mode shape (k1 + k2 − ω²) φa = k2 φb.
+    let shape = [1.0, (k1 + k2 - slow2) / k2];
+    let (gap, amplitude) = (0.5, 0.1);
+    let sliders = Sliders {
+        masses,
+        k1,
+        k2,
+        c2: 0.0,
+        gap,
+        initial: [
+            (amplitude * shape[0], 0.0),
+            (gap + amplitude * shape[1] + excite, 0.0),
+        ],
+        free: [[0.0; 3]; 2],
+    };
+    (sliders, shape.map(|s| amplitude * s), slow2.sqrt())
+}
+
+#[test]
+fn a_stiff_spring_neither_blows_up_nor_needs_a_small_step() {
+    let t_end = 1.0;
+    for rho in [1.0, 0.8, 0.0] {
+        let mut errors = vec![];
+        for h in [0.02, 0.01, 0.005] {
+            let (sliders, modal, w) = stiff_sliders(0.01, 0.0);
+            let gap = sliders.gap;
+            let mut integrator =
+                Integrator::new(Solver::new(Scene::new(sliders)), 0.0, fixed(rho, h)).unwrap();
+            integrator
+                .run(t_end, |state, _| {
+                    assert!(state.q[0].abs() < 0.2 && (state.q[3] - gap).abs() < 0.2);
+                })
+                .unwrap();
+            let exact = modal[0] * (w * t_end).cos();
+            errors.push((integrator.free_state(0)[0] - exact).abs());
+            eprintln!("ρ∞ = {rho}, h = {h}: {:?}", integrator.stats());
+            // Linear: the prediction is the answer, which the second evaluation confirms.
+            let stats = integrator.stats();
+            assert!(stats.iterations <= 2 * stats.steps + 2, "{stats:?}");
+        }
+        eprintln!("stiff ρ∞ = {rho}: errors {errors:?}");
+        assert!(errors[0] < 2e-3 && errors[1] < errors[0] / 3.0 && errors[2] < errors[1] / 3.0);
+    }
+}
+
+/// The fast mode excited: with ρ∞ = 1 its amplitude is kept (never grows), with ρ∞ < 1 it is
+/// damped out within a few steps, the slow motion untouched.
+#[test]
+fn numerical_damping_removes_an_excited_stiff_mode() {
+    let excite = 1e-4;
+    for (rho, bound) in [(1.0, 1.0 + 1e-9), (0.5, 1e-6), (0.0, 1e-6)] {
+        let (sliders, _, _) = stiff_sliders(0.01, excite);
+        let gap = sliders.gap;
+        let mut integrator =
+            Integrator::new(Solver::new(Scene::new(sliders)), 0.0, fixed(rho, 0.01)).unwrap();
+        // Stretch of the stiff spring beyond the slow mode's (k1-driven) share.
+        let fast = |i: &Integrator<Scene<Sliders>>| {
+            let q = &i.state().q;
+            let k = i.solver().mechanism().inner();
+            let quasi_static = -k.k1 * q[0] / k.k2;
+            (q[3] - q[0] - gap) + quasi_static
+        };
+        let mut largest = 0.0_f64;
+        for step in 0..40 {
+            integrator.step().unwrap();
+            if step >= 30 {
+                largest = largest.max(fast(&integrator).abs());
+            }
+        }
+        eprintln!("ρ∞ = {rho}: fast-mode amplitude after 30 steps {largest:e}");
+        assert!(largest <= bound * excite, "ρ∞ = {rho}: {largest}");
+    }
+}
+
+#[test]
+fn bad_options_are_refused_by_name() {
+    let p = FreePendulum::released(-1.0, 0.0);
+    let cases = [
+        (fixed(f64::NAN, 0.01), "rho_inf"),
+        (fixed(1.5, 0.01), "rho_inf"),
+        (fixed(0.9, 0.0), "step"),
+        (fixed(0.9, f64::INFINITY), "step"),
+        (adaptive(0.9, f64::NAN, 1e-9), "rtol"),
+        (adaptive(0.9, 0.0, 0.0), "atol"),
+        (
+            IntegratorOptions {
+                newton_tolerance: -1.0,
+                ..IntegratorOptions::default()
+            },
+            "newton_tolerance",
+        ),
+    ];
+    for (options, name) in cases {
+        match Integrator::new(Solver::new(Scene::new(p.clone())), 0.0, options) {
+            Err(DynamicsError::BadOptions { option, .. }) => assert_eq!(option, name),
+            Err(other) => panic!("{name}: {other}"),
+            Ok(_) => panic!("{name} accepted"),
+        }
+    }
+    let mut integrator = pendulum(p, fixed(0.9, 0.01));
+    integrator.step_to(0.1).unwrap();
+    for t in [f64::NAN, 0.05] {
+        let error = integrator.step_to(t).map(|_| ()).unwrap_err();
+        assert!(matches!(
+            error,
+            DynamicsError::BadOptions { option: "t", .. }
+        ));
+    }
+    let error = integrator.set_free(0, f64::INFINITY, 0.0).unwrap_err();
+    assert!(matches!(
+        error,
+        DynamicsError::BadOptions {
+            option: "value",
+            ..
+        }
+    ));
+    let error = integrator.set_free(1, 0.0, 0.0).unwrap_err();
+    assert!(matches!(
+        error,
+        DynamicsError::BadOptions { option: "free", .. }
+    ));
+    assert_eq!(integrator.t(), 0.1);
+}
+
+#[test]
+fn a_massless_free_degree_of_freedom_is_named() {
+    let mut p = FreePendulum::released(-1.0, 0.0);
+    p.mass = 0.0;
+    p.inertia = 0.0;
+    let Err(error) = Integrator::new(Solver::new(Scene::new(p)), 0.0, fixed(0.9, 0.01)) else {
+        panic!("a massless pendulum started");
+    };
+    assert!(matches!(
+        error,
+        DynamicsError::SingularMass {
+            free: 0,
+            equation: 2,
+            ..
+        }
+    ));
+    let message = error.to_string();
+    assert!(
+        message.contains("`swing`") && message.contains("no mass"),
+        "{message}"
+    );
+}
+
+#[test]
+fn the_step_falls_below_its_minimum_with_a_typed_error() {
+    let options = IntegratorOptions {
+        control: StepControl::Adaptive {
+            rtol: 1e-14,
+            atol: 1e-16,
+            initial: 0.1,
+            min: 0.05,
+            max: 1.0,
+        },
+        ..IntegratorOptions::default()
+    };
+    let mut integrator = pendulum(FreePendulum::released(-1.0, 0.0), options);
+    let error = integrator.step().map(|_| ()).unwrap_err();
+    assert!(
+        matches!(error, DynamicsError::StepTooSmall { min: 0.05, .. }),
+        "{error}"
+    );
+    assert_eq!(integrator.t(), 0.0);
+    assert!(integrator.free_state(0).iter().all(|x| x.is_finite()));
+}
+
+#[test]
+fn newton_failure_is_a_typed_error() {
+    let options = IntegratorOptions {
+        max_iterations: 1,
+        newton_tolerance: 1e-300,
+        ..fixed(0.9, 0.05)
+    };
+    let mut integrator = pendulum(FreePendulum::released(-1.0, 3.0), options);
+    let error = integrator.step().map(|_| ()).unwrap_err();
+    assert!(
+        matches!(error, DynamicsError::NoConvergence { iterations: 1, .. }),
+        "{error}"
+    );
+    assert_eq!(integrator.t(), 0.0);
+}
+
+/// The free coordinate x cannot pass the rod's reach: where the rod is horizontal the
+/// partition is singular (a toggle for the free motion: `V = ∂q/∂x` is infinite there), and
+/// the step that meets it fails with a typed error at that time, the state before it kept.
+#[test]
+fn a_toggle_met_by_the_free_motion_is_a_typed_error() {
+    let mut p = FreePendulum::released(-2.0, 0.0);
+    p.free_x = true;
+    // x = L cos(−2) moving right fast enough to swing past horizontal (x = L, θ = 0).
+    let speed = 8.0;
+    p.initial = (Some(p.length * (-2.0_f64).cos()), speed);
+    let rate = speed / (-p.length * (-2.0_f64).sin());
+    let toggle = (1..)
+        .map(|k| 1e-3 * k as f64)
+        .find(|&t| reference(&p, -2.0, rate, t).0 >= 0.0)
+        .unwrap();
+    for options in [fixed(0.9, 0.01), adaptive(0.9, 1e-6, 1e-9)] {
+        let mut integrator = pendulum(p.clone(), options);
+        let Err(error) = integrator.step_to(2.0).map(|_| ()) else {
+            panic!("passed the toggle");
+        };
+        let described = integrator.describe(&error).to_string();
+        eprintln!("toggle at {toggle}: {described}");
+        assert!(
+            matches!(
+                error,
+                DynamicsError::Toggle { .. }
+                    | DynamicsError::Solve { .. }
+                    | DynamicsError::NoConvergence { .. }
+            ),
+            "{described}"
+        );
+        let t = error.time().unwrap();
+        assert!(
+            (toggle - 0.03..toggle + 0.02).contains(&t),
+            "{t} vs {toggle}"
+        );
+        assert!(integrator.t() < toggle);
+        assert!(integrator.state().q.iter().all(|x| x.is_finite()));
+    }
+}
+
+/// A free value not declared is the driven quantity at the scene's guess, assembled.
+#[test]
+fn an_undeclared_initial_value_comes_from_the_guess() {
+    let mut p = FreePendulum::released(-1.2, 0.0);
+    p.initial = (None, 0.5);
+    let integrator = pendulum(p, fixed(0.9, 0.01));
+    let [u, ud, udd] = integrator.free_state(0);
+    assert!((u + 1.2).abs() < 1e-12 && ud == 0.5);
+    let p = integrator.solver().mechanism().inner();
+    assert!((udd - p.theta_ddot(-1.2, 0.5)).abs() < 1e-12);
+    assert!(integrator.solver().mechanism().coordinate_name(2) == Some("bob.theta"));
+}
