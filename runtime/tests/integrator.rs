@@ -12,7 +12,7 @@ use common::scene::Scene;
 use common::sliders::Sliders;
 use core::f64::consts::{FRAC_PI_2, PI};
 use mechgen_runtime::{
-    DynamicsError, Integrator, IntegratorOptions, Mechanism, Solver, StepControl, Vector,
+    DynamicsError, Integrator, IntegratorOptions, Mechanism, Solver, StepControl,
 };
 
 type Pendulum = Integrator<Scene<FreePendulum>>;
