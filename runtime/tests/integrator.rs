@@ -162,7 +162,7 @@ fn a_large_swing_returns_after_the_elliptic_period() {
     let amplitude = 2.5;
     let p = FreePendulum::released(-FRAC_PI_2 + amplitude, 0.0);
     let period = 4.0 * elliptic_k((0.5 * amplitude).sin()) / p.omega();
-    let mut integrator = pendulum(p, adaptive(0.9, 1e-9, 1e-12));
+    let mut integrator = pendulum(p, adaptive(0.9, 1e-7, 1e-10));
     integrator.step_to(period).unwrap();
     let [u, ud, _] = integrator.free_state(0);
     eprintln!(
@@ -487,4 +487,131 @@ fn an_undeclared_initial_value_comes_from_the_guess() {
     let p = integrator.solver().mechanism().inner();
     assert!((udd - p.theta_ddot(-1.2, 0.5)).abs() < 1e-12);
     assert!(integrator.solver().mechanism().coordinate_name(2) == Some("bob.theta"));
+}
+
+/// Error control: the global error against the reference stays within a few × the
+/// tolerance (which is per second of simulated time: 5 s here) and follows it in proportion,
+/// the steps growing as tol^(−1/2) (local error O(h³) against a tolerance ∝ h).
+#[test]
+fn the_error_controlled_mode_follows_its_tolerance() {
+    let theta0 = -FRAC_PI_2 + 1.0;
+    let p = FreePendulum::released(theta0, 0.0);
+    let times: Vec<f64> = (1..=10).map(|k| 0.5 * k as f64).collect();
+    let exact: Vec<(f64, f64)> = times
+        .iter()
+        .map(|&t| reference(&p, theta0, 0.0, t))
+        .collect();
+    let mut results = vec![];
+    for rtol in [1e-4, 1e-6, 1e-8] {
+        let mut integrator = pendulum(p.clone(), adaptive(0.9, rtol, 1e-3 * rtol));
+        let mut error = 0.0_f64;
+        for (&t, &(theta, _)) in times.iter().zip(&exact) {
+            integrator.step_to(t).unwrap();
+            assert_eq!(integrator.t(), t);
+            error = error.max((integrator.free_state(0)[0] - theta).abs());
+        }
+        // The tolerance on θ: rtol |θ| with |θ| ≤ π/2 + 1.
+        let tolerance = rtol * (FRAC_PI_2 + 1.0);
+        let stats = integrator.stats();
+        eprintln!(
+            "rtol {rtol:e}: largest error {error:.3e} = {:.1} × tolerance, {stats:?}",
+            error / tolerance
+        );
+        // Per second over 5 s: a few × 5 × the tolerance.
+        assert!(error < 15.0 * tolerance, "rtol {rtol}: {error}");
+        results.push((error, stats.steps as f64));
+    }
+    for pair in results.windows(2) {
+        let (errors, steps) = (pair[0].0 / pair[1].0, pair[1].1 / pair[0].1);
+        eprintln!("100× tighter: error ÷ {errors:.1}, steps × {steps:.2}");
+        assert!((40.0..250.0).contains(&errors), "{errors}");
+        assert!((6.0..15.0).contains(&steps), "{steps}");
+    }
+}
+
+/// The energy book against the reference: the kinetic energy is ½ I θ̇² of the pin, the
+/// gravity potential m g y, and with ρ∞ = 1 (no numerical damping) the total of an undamped
+/// swing stays within a bound that does not grow over 1,000 periods.
+#[test]
+fn an_undamped_swing_keeps_its_energy_over_a_thousand_periods() {
+    let amplitude = 0.5;
+    let p = FreePendulum::released(-FRAC_PI_2 + amplitude, 0.0);
+    let period = 4.0 * elliptic_k((0.5 * amplitude).sin()) / p.omega();
+    let (inertia, m, g, l) = (p.pin_inertia(), p.mass, p.gravity, p.length);
+    let mut integrator = pendulum(p, fixed(1.0, period / 40.0));
+    let start = integrator.energy();
+    let e0 = start.total();
+    // The swing's energy scale: the potential it turns into kinetic energy.
+    let scale = m * g * l * (1.0 - amplitude.cos());
+    assert!((start.gravity - m * g * (-l * amplitude.cos())).abs() < 1e-12 * scale);
+    let (mut early, mut late, mut book) = (0.0_f64, 0.0_f64, 0.0_f64);
+    let periods = 1000.0;
+    integrator
+        .run(periods * period, |state, energy| {
+            let drift = (energy.total() - e0).abs() / scale;
+            if state.t < 10.0 * period {
+                early = early.max(drift);
+            }
+            if state.t > (periods - 10.0) * period {
+                late = late.max(drift);
+            }
+            let kinetic = 0.5 * inertia * state.qd().z * state.qd().z;
+            book = book.max((energy.kinetic - kinetic).abs() / scale);
+        })
+        .unwrap();
+    eprintln!(
+        "1000 periods at h = T/40: |ΔE|/E_swing ≤ {early:.3e} (first 10), {late:.3e} (last 10); \
+         {:?}",
+        integrator.stats()
+    );
+    assert!(book < 1e-12, "{book}");
+    assert!(early < 2e-3 && late < 2e-3, "{early} {late}");
+    // Bounded, not drifting: the last periods are no worse than the first ones.
+    assert!(late < 1.5 * early, "{early} {late}");
+}
+
+/// A damped swing loses what the damper dissipates: the book's dissipation against the
+/// reference's `∫ c θ̇² dt` (integrated with the Lagrange equation by RK4), and the balance
+/// `kinetic + gravity + dissipated` constant.
+#[test]
+fn a_damped_swing_loses_what_the_damper_dissipates() {
+    let theta0 = -FRAC_PI_2 + 1.2;
+    let mut p = FreePendulum::released(theta0, 0.0);
+    p.damping = 0.8;
+    // Reference: (θ, θ̇, D) with D' = c θ̇², RK4 with steps of 1e-4.
+    let t_end = 5.0;
+    let n = 50_000;
+    let h = t_end / n as f64;
+    let f = |y: [f64; 3]| [y[1], p.theta_ddot(y[0], y[1]), p.damping * y[1] * y[1]];
+    let mut y = [theta0, 0.0, 0.0];
+    for _ in 0..n {
+        let k1 = f(y);
+        let k2 = f(core::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
+        let k3 = f(core::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
+        let k4 = f(core::array::from_fn(|i| y[i] + h * k3[i]));
+        y = core::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+    }
+    for (rho, step) in [(1.0, 2e-3), (0.8, 1e-3)] {
+        let mut integrator = pendulum(p.clone(), fixed(rho, step));
+        let e0 = integrator.energy().total();
+        let mut balance = 0.0_f64;
+        integrator
+            .run(t_end, |_, energy| {
+                balance = balance.max((energy.total() - e0).abs())
+            })
+            .unwrap();
+        let energy = integrator.energy();
+        let relative = (energy.dissipated - y[2]).abs() / y[2];
+        eprintln!(
+            "ρ∞ = {rho}, h = {step}: dissipated {:.6} vs {:.6} (relative {relative:.1e}), \
+             balance within {:.1e} of {:.3}",
+            energy.dissipated, y[2], balance, y[2]
+        );
+        assert!(relative < 2e-4, "{relative}");
+        assert!(balance < 2e-4 * y[2], "{balance}");
+        assert_eq!(
+            (energy.loads_work, energy.drivers_work.abs() < 1e-9),
+            (0.0, true)
+        );
+    }
 }

@@ -208,4 +208,34 @@ mod tests {
             }
         }
     }
+
+    /// The local error of `u` over one step from exact data of the oscillator `u = cos t`
+    /// (with `a_n` the exact acceleration at `t_n + (α_m − α_f) h`, where the method's `a`
+    /// lives) is `C h³ u⃛`, with the constant of [`Alpha::error_constant`].
+    #[test]
+    fn the_error_constant_is_the_local_error_of_u() {
+        for rho in [0.0, 0.5, 0.9, 1.0] {
+            let alpha = Alpha::new(rho);
+            let shift = alpha.alpha_m - alpha.alpha_f;
+            let t0 = 0.7;
+            let mut ratios = [0.0; 2];
+            for (ratio, h) in ratios.iter_mut().zip([1e-2, 5e-3]) {
+                let mut from = FreeMotion::new(nalgebra::Const::<1>);
+                from.u[0] = libm::cos(t0);
+                from.ud[0] = -libm::sin(t0);
+                from.udd[0] = -libm::cos(t0);
+                from.a[0] = -libm::cos(t0 + shift * h);
+                // ü_{n+1} exact: the local error is the update's alone.
+                let mut to = FreeMotion::new(nalgebra::Const::<1>);
+                to.udd[0] = -libm::cos(t0 + h);
+                to.advance(&from, &alpha, h);
+                let error = to.u[0] - libm::cos(t0 + h);
+                // u⃛ = sin t.
+                *ratio = error / (alpha.error_constant() * h * h * h * libm::sin(t0));
+            }
+            for ratio in ratios {
+                assert!((ratio - 1.0).abs() < 0.05, "ρ∞ = {rho}: {ratios:?}");
+            }
+        }
+    }
 }

@@ -11,8 +11,10 @@ pub enum StepControl {
         /// Step size (s).
         step: f64,
     },
-    /// Steps sized so that the estimated local error of every free coordinate stays below
-    /// `atol + rtol·|u|` (in the coordinate's units: radians, scene lengths).
+    /// Steps sized so that the estimated local error each step adds to every free
+    /// coordinate stays below `(atol + rtol·|u|)` per second of simulated time (in the
+    /// coordinate's units: radians, scene lengths): the error after T seconds is then about
+    /// T × the tolerance.
     Adaptive {
         /// Relative tolerance.
         rtol: f64,
