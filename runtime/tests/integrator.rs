@@ -7,6 +7,7 @@
 
 mod common;
 
+use common::cart_pendulum::CartPendulum;
 use common::free_pendulum::FreePendulum;
 use common::scene::Scene;
 use common::sliders::Sliders;
@@ -614,4 +615,69 @@ fn a_damped_swing_loses_what_the_damper_dissipates() {
             (0.0, true)
         );
     }
+}
+
+/// A driver and a free degree of freedom in one scene: the pendulum on a shaken cart follows
+/// its Lagrange equation, and the book's drivers' work is the reference's `∫ f ẋ_c dt`, the
+/// balance with it constant.
+#[test]
+fn a_driver_and_a_free_swing_mix_and_the_drivers_work_is_booked() {
+    let scene = CartPendulum::default();
+    let t_end = 3.0;
+    // Reference: (θ, θ̇, W) with W' = the driver's power, RK4 with steps of 1e-4.
+    let n = 30_000;
+    let h = t_end / n as f64;
+    let f = |t: f64, y: [f64; 3]| {
+        [
+            y[1],
+            scene.theta_ddot(t, y[0]),
+            scene.drive_power(t, y[0], y[1]),
+        ]
+    };
+    let mut y = [scene.theta0, 0.0, 0.0];
+    for i in 0..n {
+        let t = i as f64 * h;
+        let k1 = f(t, y);
+        let k2 = f(
+            t + 0.5 * h,
+            core::array::from_fn(|i| y[i] + 0.5 * h * k1[i]),
+        );
+        let k3 = f(
+            t + 0.5 * h,
+            core::array::from_fn(|i| y[i] + 0.5 * h * k2[i]),
+        );
+        let k4 = f(t + h, core::array::from_fn(|i| y[i] + h * k3[i]));
+        y = core::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+    }
+    let mut integrator = Integrator::new(
+        Solver::new(Scene::new(scene.clone())),
+        0.0,
+        adaptive(0.9, 1e-7, 1e-10),
+    )
+    .unwrap();
+    let e0 = integrator.energy().total();
+    let mut balance = 0.0_f64;
+    integrator
+        .run(t_end, |_, energy| {
+            balance = balance.max((energy.total() - e0).abs())
+        })
+        .unwrap();
+    let [u, ud, _] = integrator.free_state(0);
+    let energy = integrator.energy();
+    eprintln!(
+        "cart: θ error {:.2e}, θ̇ error {:.2e}, drivers' work {:.6} vs {:.6}, balance {balance:.1e}, {:?}",
+        u - y[0],
+        ud - y[1],
+        energy.drivers_work,
+        y[2],
+        integrator.stats()
+    );
+    assert!((u - y[0]).abs() < 1e-5 && (ud - y[1]).abs() < 1e-4);
+    let scale = y[2].abs().max(1.0);
+    assert!((energy.drivers_work - y[2]).abs() < 1e-4 * scale);
+    assert!(balance < 1e-4 * scale, "{balance}");
+    // The cart follows its driver exactly.
+    let cart = scene.cart_motion(t_end);
+    let state = integrator.state();
+    assert!((state.q[0] - cart[0]).abs() < 1e-12 && (state.qd()[0] - cart[1]).abs() < 1e-12);
 }
