@@ -8,6 +8,7 @@
 mod common;
 
 use common::cart_pendulum::CartPendulum;
+use common::double_pendulum::DoublePendulum;
 use common::free_pendulum::FreePendulum;
 use common::scene::Scene;
 use common::sliders::Sliders;
@@ -680,4 +681,88 @@ fn a_driver_and_a_free_swing_mix_and_the_drivers_work_is_booked() {
     let cart = scene.cart_motion(t_end);
     let state = integrator.state();
     assert!((state.q[0] - cart[0]).abs() < 1e-12 && (state.qd()[0] - cart[1]).abs() < 1e-12);
+}
+
+/// `[θ1, θ2, θ̇1, θ̇2]` of the double pendulum at `t` from rest, by RK4 with steps of 1e-4.
+fn double_reference(p: &DoublePendulum, t: f64) -> [f64; 4] {
+    let n = (t / 1e-4).ceil() as usize;
+    let h = t / n as f64;
+    let f = |y: [f64; 4]| {
+        let [a, b] = p.accelerations([y[0], y[1]], [y[2], y[3]]);
+        [y[2], y[3], a, b]
+    };
+    let mut y = [p.theta0[0], p.theta0[1], 0.0, 0.0];
+    for _ in 0..n {
+        let k1 = f(y);
+        let k2 = f(core::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
+        let k3 = f(core::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
+        let k4 = f(core::array::from_fn(|i| y[i] + h * k3[i]));
+        y = core::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+    }
+    y
+}
+
+/// Two coupled free degrees of freedom: the double pendulum against its reduced-coordinate
+/// equations, second order in fixed steps and within the tolerance in the error-controlled
+/// mode, its energy kept.
+#[test]
+fn a_double_pendulum_follows_its_reduced_equations() {
+    let p = DoublePendulum::default();
+    let t_end = 2.0;
+    let exact = double_reference(&p, t_end);
+    let error = |integrator: &Integrator<Scene<DoublePendulum>>| {
+        let [a, b] = [0, 1].map(|k| integrator.free_state(k)[0]);
+        (a - exact[0]).abs().max((b - exact[1]).abs())
+    };
+    let mut errors = vec![];
+    for h in [0.01, 0.005] {
+        let mut integrator =
+            Integrator::new(Solver::new(Scene::new(p.clone())), 0.0, fixed(0.8, h)).unwrap();
+        integrator.step_to(t_end).unwrap();
+        errors.push(error(&integrator));
+    }
+    let mut integrator = Integrator::new(
+        Solver::new(Scene::new(p.clone())),
+        0.0,
+        adaptive(0.9, 1e-7, 1e-10),
+    )
+    .unwrap();
+    let e0 = integrator.energy().total();
+    integrator.step_to(t_end).unwrap();
+    let adaptive_error = error(&integrator);
+    let drift = (integrator.energy().total() - e0).abs();
+    eprintln!(
+        "double pendulum: fixed errors {errors:?}, ratio {:.2}; error-controlled {adaptive_error:.2e}, \
+         energy drift {drift:.1e}, {:?}",
+        errors[0] / errors[1],
+        integrator.stats()
+    );
+    assert!((3.5..4.6).contains(&(errors[0] / errors[1])));
+    assert!(adaptive_error < 15.0 * 1e-7 * t_end, "{adaptive_error}");
+    assert!(drift < 1e-5, "{drift}");
+}
+
+/// `set_free` restarts the motion from a new free state: the motion afterwards is the
+/// reference's from that state, and the energy book jumps by exactly the energy it adds.
+#[test]
+fn set_free_restarts_the_motion_from_the_new_state() {
+    let p = FreePendulum::released(-1.0, 0.0);
+    let mut integrator = pendulum(p.clone(), adaptive(0.9, 1e-8, 1e-11));
+    integrator.step_to(0.3).unwrap();
+    let before = integrator.energy();
+    integrator.set_free(0, -2.0, 1.5).unwrap();
+    assert_eq!(integrator.free_state(0)[..2], [-2.0, 1.5]);
+    assert!((integrator.free_state(0)[2] - p.theta_ddot(-2.0, 1.5)).abs() < 1e-12);
+    let after = integrator.energy();
+    let (m, g, l) = (p.mass, p.gravity, p.length);
+    let expected = 0.5 * p.pin_inertia() * 1.5 * 1.5 + m * g * l * (-2.0_f64).sin();
+    assert!((after.kinetic + after.gravity - expected).abs() < 1e-12 * expected.abs());
+    assert_eq!(after.dissipated, before.dissipated);
+    integrator.step_to(1.3).unwrap();
+    let (theta, rate) = reference(&p, -2.0, 1.5, 1.0);
+    let [u, ud, _] = integrator.free_state(0);
+    assert!(
+        (u - theta).abs() < 1e-6 && (ud - rate).abs() < 1e-5,
+        "{u} {theta}"
+    );
 }
