@@ -53,14 +53,14 @@ where
                         };
                         return Ok(());
                     }
-                    self.retry(h * resize(ratio), min, Failure::Rejected)?;
+                    self.retry((h, t), h * resize(ratio), min, Failure::Rejected)?;
                 }
                 (Err(failure), None) => return Err(self.failure(failure, t, h)),
                 (Err(Failure::SingularMass(k)), Some(_)) => {
                     return Err(self.failure(Failure::SingularMass(k), t, h));
                 }
                 (Err(failure), Some((_, _, min))) => {
-                    self.retry(h * RETRY_SHRINK, min, failure)?;
+                    self.retry((h, t), h * RETRY_SHRINK, min, failure)?;
                 }
             }
         }
@@ -85,19 +85,29 @@ where
         }
     }
 
-    /// Counts a rejection and sets the next try's step, unless it is below `min`: then the
-    /// last failure's error (a kinematic failure stays one: the motion met a toggle), or
-    /// [`DynamicsError::StepTooSmall`].
-    fn retry(&mut self, h: f64, min: f64, failure: Failure) -> Result<(), DynamicsError> {
+    /// Counts the rejection of the attempt `(h, t)` (its step and end) and sets the next
+    /// try's step, unless it is below `min`: then the attempt's error if the kinematics failed
+    /// or the partition met a toggle (a smaller step does not cure those), otherwise
+    /// [`DynamicsError::StepTooSmall`] with the step refused.
+    fn retry(
+        &mut self,
+        (h, t): (f64, f64),
+        next: f64,
+        min: f64,
+        failure: Failure,
+    ) -> Result<(), DynamicsError> {
         self.stats.rejected += 1;
-        if h >= min {
-            self.step = h;
+        if next >= min {
+            self.step = next;
             return Ok(());
         }
-        let t = self.state.t;
         Err(match failure {
-            Failure::Kinematics(_) | Failure::Toggle => self.failure(failure, t + h, h),
-            _ => DynamicsError::StepTooSmall { t, step: h, min },
+            Failure::Kinematics(_) | Failure::Toggle => self.failure(failure, t, h),
+            _ => DynamicsError::StepTooSmall {
+                t: self.state.t,
+                step: next,
+                min,
+            },
         })
     }
 

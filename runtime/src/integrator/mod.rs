@@ -203,6 +203,9 @@ where
             },
             Failure::NonFinite(free) => DynamicsError::NonFinite { t, step: h, free },
             Failure::Toggle => DynamicsError::Toggle { t, step: h },
+            // A singular iteration matrix (a negative stiffness as large as the mass) is an
+            // iteration that cannot go on; `Rejected` never gets here (the step control
+            // reports it as `StepTooSmall`).
             Failure::SingularMatrix | Failure::Rejected => DynamicsError::NoConvergence {
                 t,
                 step: h,

@@ -31,6 +31,8 @@ pub struct FreePendulum {
     pub guess: f64,
     /// `[u, u̇, ü]`, set by the integrator.
     pub free: [f64; 3],
+    /// From this time on the forces are NaN (a load whose expression fails).
+    pub nan_after: f64,
 }
 
 impl FreePendulum {
@@ -46,6 +48,7 @@ impl FreePendulum {
             initial: (Some(theta0), rate),
             guess: theta0,
             free: [0.0; 3],
+            nan_after: f64::INFINITY,
         }
     }
 
@@ -161,8 +164,13 @@ impl Mechanism for FreePendulum {
         let (l, th, w) = (self.length, q.z, qd.z);
         *out = Q::from([-l * cos(th) * w * w, -l * sin(th) * w * w, self.free[2]]);
     }
-    fn generalized_forces(&self, _: &Q, qd: &Q, qdd: &Q, _: f64, out: &mut Q) {
-        let (m, j, g) = (self.mass, self.inertia, self.gravity);
+    fn generalized_forces(&self, _: &Q, qd: &Q, qdd: &Q, t: f64, out: &mut Q) {
+        let (m, j) = (self.mass, self.inertia);
+        let g = if t < self.nan_after {
+            self.gravity
+        } else {
+            f64::NAN
+        };
         *out = Q::from([
             -m * qdd.x,
             -m * g - m * qdd.y,
