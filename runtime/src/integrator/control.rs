@@ -121,6 +121,8 @@ where
 
     /// Makes the step's iterate the current state and books its energy.
     fn accept(&mut self, h: f64) {
+        self.earlier.copy_from(&self.now.udd);
+        self.earlier_step = h;
         core::mem::swap(&mut self.state, &mut self.trial);
         core::mem::swap(&mut self.now, &mut self.next);
         let m = self.solver.mechanism();

@@ -79,6 +79,10 @@ where
     matrix: IterationMatrix<M::Free>,
     /// The last Newton correction.
     correction: OVector<f64, M::Free>,
+    /// The free accelerations one step back and that step's size (0: none since the last
+    /// start), for the predictor's extrapolation.
+    earlier: OVector<f64, M::Free>,
+    earlier_step: f64,
     alpha: Alpha,
     options: IntegratorOptions,
     /// The next step's size.
@@ -151,6 +155,8 @@ where
             reduced: Reduced::new(m),
             matrix,
             correction: OVector::zeros_generic(f, U1),
+            earlier: OVector::zeros_generic(f, U1),
+            earlier_step: 0.0,
             alpha: Alpha::new(options.rho_inf),
             options,
             step,
@@ -183,6 +189,7 @@ where
         solved.map_err(|failure| self.failure(failure, t, 0.0))?;
         self.next.a.copy_from(&self.next.udd);
         self.sensitivity = self.reduced.v.norm();
+        self.earlier_step = 0.0;
         core::mem::swap(&mut self.state, &mut self.trial);
         core::mem::swap(&mut self.now, &mut self.next);
         let m = self.solver.mechanism();

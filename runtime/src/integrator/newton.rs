@@ -31,6 +31,9 @@ const CONTRACTION: f64 = 0.5;
 /// Accelerations below this many scene scales per step squared count as zero for the
 /// relative Newton test (a state at rest).
 const ACCELERATION_FLOOR: f64 = 1e-6;
+/// The share of the iteration matrix (largest scaled entries) above which stiffness and
+/// damping make a step stiff.
+const STIFF_SHARE: f64 = 0.5;
 /// How far `‖V‖` may grow past its value at the start before the state counts as at a
 /// toggle of the partition: the reduced mass then grew about a million times.
 const TOGGLE_GROWTH: f64 = 1e3;
@@ -71,6 +74,9 @@ where
     stiffness: OMatrix<f64, F, F>,
     /// Whether the scene has `C`, `K`; whether the parts exist at all.
     has: (bool, bool),
+    /// Whether `γ' C_r + β' K_r` outweighs [`STIFF_SHARE`] of the mass in the last
+    /// combination: the step is then in the stiff regime, where the linear model predicts.
+    pub stiff: bool,
     built: bool,
     /// `S` (and the mass check's elimination).
     scratch: OMatrix<f64, F, F>,
@@ -100,6 +106,7 @@ where
             damping: square(),
             stiffness: square(),
             has: (false, false),
+            stiff: false,
             built: false,
             scratch: square(),
             lu: Lu::new(f),
@@ -122,6 +129,15 @@ where
         if self.has.1 {
             self.scratch.zip_apply(&self.stiffness, |a, b| *a += du * b);
         }
+        let (mut mass, mut rest) = (0.0_f64, 0.0_f64);
+        for j in 0..self.mass.ncols() {
+            for i in 0..self.mass.nrows() {
+                let scale = self.scales[i] * self.scales[j];
+                mass = mass.max((self.mass[(i, j)] * scale).abs());
+                rest = rest.max(((self.scratch[(i, j)] - self.mass[(i, j)]) * scale).abs());
+            }
+        }
+        self.stiff = rest > STIFF_SHARE * mass;
         let matrix = &self.scratch;
         self.lu
             .factor_scaled_with(&self.scales, &self.scales, |s| s.copy_from(matrix))
@@ -250,9 +266,12 @@ where
         })
     }
 
-    /// Starts a step from the linearly implicit prediction (see the module documentation),
-    /// and the kinematic solve warm-started from the positions that predicted state gives to
-    /// first order, `q + V (u_{n+1} − u_n)` (`V` of the last evaluation).
+    /// Starts a step from a prediction of `ü_{n+1}`: in the stiff regime the linearly implicit
+    /// one (see the module documentation); otherwise the accelerations extrapolated from the
+    /// last two steps, `ü_n + (h / h_{n−1}) (ü_n − ü_{n−1})`, O(h²) off on a smooth motion
+    /// (where "ü unchanged" is O(h) off), so the iteration usually ends at its second
+    /// evaluation. The kinematic solve is warm-started from the positions the predicted state
+    /// gives to first order, `q + V (u_{n+1} − u_n)` (`V` of the last evaluation).
     fn predict(&mut self, h: f64) -> Result<(), Failure> {
         let derivatives = self.alpha.derivatives(h);
         if self.matrix.built && self.matrix.step != Some(h) {
@@ -261,24 +280,16 @@ where
             self.stats.factorizations += 1;
         }
         self.next.copy_from(&self.now);
+        let linear = self.matrix.built && self.matrix.stiff;
+        if !linear && self.earlier_step > 0.0 {
+            let ratio = h / self.earlier_step;
+            for k in 0..self.next.udd.len() {
+                self.next.udd[k] += ratio * (self.now.udd[k] - self.earlier[k]);
+            }
+        }
         self.next.advance(&self.now, &self.alpha, h);
-        let it = &mut self.matrix;
-        if it.built && (it.has.0 || it.has.1) {
-            // rhs = −C_r (u̇⁰ − u̇_n) − K_r (u⁰ − u_n), into `last` (scratch here).
-            it.last.fill(0.0);
-            self.correction.copy_from(&self.next.ud);
-            self.correction -= &self.now.ud;
-            if it.has.0 {
-                it.last.gemv(-1.0, &it.damping, &self.correction, 1.0);
-            }
-            self.correction.copy_from(&self.next.u);
-            self.correction -= &self.now.u;
-            if it.has.1 {
-                it.last.gemv(-1.0, &it.stiffness, &self.correction, 1.0);
-            }
-            self.correction.gemv(1.0, &it.inverse, &it.last, 0.0);
-            self.next.udd += &self.correction;
-            self.next.advance(&self.now, &self.alpha, h);
+        if linear {
+            self.linear_prediction(h);
         }
         self.trial.copy_from(&self.state);
         self.correction.copy_from(&self.next.u);
@@ -287,6 +298,27 @@ where
             .q
             .gemv(1.0, &self.reduced.v, &self.correction, 1.0);
         Ok(())
+    }
+
+    /// Corrects `next` (advanced with `ü_{n+1} = ü_n`) by the step of the reduced linear
+    /// model: `S Δü = −C_r (u̇⁰ − u̇_n) − K_r (u⁰ − u_n)`.
+    fn linear_prediction(&mut self, h: f64) {
+        let it = &mut self.matrix;
+        // The right-hand side, in `last` (scratch until the first correction).
+        it.last.fill(0.0);
+        if it.has.0 {
+            self.correction.copy_from(&self.next.ud);
+            self.correction -= &self.now.ud;
+            it.last.gemv(-1.0, &it.damping, &self.correction, 1.0);
+        }
+        if it.has.1 {
+            self.correction.copy_from(&self.next.u);
+            self.correction -= &self.now.u;
+            it.last.gemv(-1.0, &it.stiffness, &self.correction, 1.0);
+        }
+        self.correction.gemv(1.0, &it.inverse, &it.last, 0.0);
+        self.next.udd += &self.correction;
+        self.next.advance(&self.now, &self.alpha, h);
     }
 
     /// The converged state is on the same side of every singular configuration as the
