@@ -10,9 +10,10 @@
 //! residuals the iteration sees, so those terms slow it little. The scene's springs and
 //! dampers are in `K` and `C` exactly, so a stiff spring does not slow it at all.
 //!
-//! Each step starts from the linearly implicit prediction: the step the reduced linear model
-//! `M_r Δü + C_r Δu̇ + K_r Δu = 0` about the current state takes, which for a stiff spring is
-//! close to the answer where "ü unchanged" would stretch it by `h² ü`.
+//! Each step starts from a prediction (`predict`): in the stiff regime the linearly implicit
+//! step of the reduced linear model `M_r Δü + C_r Δu̇ + K_r Δu = 0` about the current state,
+//! which for a stiff spring is close to the answer where "ü unchanged" would stretch it by
+//! `h² ü`; otherwise the accelerations extrapolated from the last two steps.
 
 use nalgebra::{DefaultAllocator, Dim, OMatrix, OVector, U1};
 
