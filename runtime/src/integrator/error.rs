@@ -119,7 +119,8 @@ impl DynamicsError {
         }
     }
 
-    /// Writes the message, naming free degree of freedom `k` with `free`.
+    /// Writes the message, naming free degree of freedom `k` with `free`. One arm per
+    /// variant, the messages side by side (long, but one phase).
     fn write(
         &self,
         f: &mut fmt::Formatter<'_>,

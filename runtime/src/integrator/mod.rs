@@ -127,14 +127,20 @@ where
                 free: Some(k),
             });
         }
-        set_free(&mut solver, &initial);
-        let simulation = Simulation::new(solver, t0).map_err(|f| DynamicsError::Solve {
-            t: t0,
-            step: 0.0,
-            error: f.error,
-        })?;
-        let state = simulation.state().clone();
-        let solver = simulation.into_solver();
+        let (state, solver) = assemble(solver, &initial, t0)?;
+        let mut integrator = Self::with_state(solver, state, initial, options);
+        integrator.restart()?;
+        Ok(integrator)
+    }
+
+    /// The integrator's storage around an assembled `state` with free coordinates `initial`
+    /// (accelerations not yet solved).
+    fn with_state(
+        solver: Solver<M>,
+        state: State<M>,
+        initial: FreeMotion<M::Free>,
+        options: IntegratorOptions,
+    ) -> Self {
         let m = solver.mechanism();
         let f = m.free();
         let mut matrix = IterationMatrix::new(f);
@@ -147,7 +153,7 @@ where
             StepControl::Fixed { step } => step,
             StepControl::Adaptive { initial, .. } => initial,
         };
-        let mut integrator = Self {
+        Self {
             trial: state.clone(),
             state,
             now: initial.clone(),
@@ -164,9 +170,7 @@ where
             book: Book::new(m),
             stats: IntegratorStats::default(),
             solver,
-        };
-        integrator.restart()?;
-        Ok(integrator)
+        }
     }
 
     /// Starts the motion from the free values and rates in `next` at the current time: the
@@ -376,6 +380,27 @@ where
             })
         }
     }
+}
+
+/// Assembles the scene at `t0` with the free coordinates at `initial` (as
+/// [`Simulation::new`] does for a driven scene: from the `near` guesses at t = 0, the motion
+/// followed to `t0`), and gives the solved state and the solver back.
+fn assemble<M: Dynamic + Structured>(
+    mut solver: Solver<M>,
+    initial: &FreeMotion<M::Free>,
+    t0: f64,
+) -> Result<(State<M>, Solver<M>), DynamicsError>
+where
+    DefaultAllocator: Storage<M::Dim> + FreeStorage<M::Dim, M::Free>,
+{
+    set_free(&mut solver, initial);
+    let simulation = Simulation::new(solver, t0).map_err(|f| DynamicsError::Solve {
+        t: t0,
+        step: 0.0,
+        error: f.error,
+    })?;
+    let state = simulation.state().clone();
+    Ok((state, simulation.into_solver()))
 }
 
 /// The declared initial values and rates of the free degrees of freedom; a value not declared
