@@ -848,3 +848,33 @@ fn random_initial_states_stay_second_order_accurate() {
         );
     }
 }
+
+/// The interpreter's shape of scene: the same pendulum behind `Dyn` coordinates and free
+/// degrees of freedom (storage allocated once by `new`) takes bit-identical steps.
+#[cfg(feature = "alloc")]
+#[test]
+fn a_dyn_scene_steps_exactly_as_the_fixed_size_one() {
+    use common::free_pendulum::DynFreePendulum;
+    let p = FreePendulum::released(-0.7, 1.1);
+    for options in [fixed(0.8, 0.01), adaptive(0.9, 1e-6, 1e-9)] {
+        let mut fixed_size = pendulum(p.clone(), options);
+        let mut dynamic = Integrator::new(
+            Solver::new(Scene::new(DynFreePendulum(p.clone()))),
+            0.0,
+            options,
+        )
+        .unwrap();
+        for _ in 0..50 {
+            fixed_size.step().unwrap();
+            dynamic.step().unwrap();
+            assert_eq!(fixed_size.t(), dynamic.t());
+            assert_eq!(fixed_size.free_state(0), dynamic.free_state(0));
+            assert_eq!(
+                fixed_size.state().q.as_slice(),
+                dynamic.state().q.as_slice()
+            );
+        }
+        assert_eq!(fixed_size.energy(), dynamic.energy());
+        assert_eq!(fixed_size.stats(), dynamic.stats());
+    }
+}

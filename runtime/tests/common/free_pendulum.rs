@@ -235,3 +235,174 @@ impl Dynamic for FreePendulum {
         }
     }
 }
+
+/// The same pendulum behind `Dyn` dimensions (coordinates and free degrees of freedom), as
+/// the interpreter presents a scene.
+#[cfg(feature = "alloc")]
+pub struct DynFreePendulum(pub FreePendulum);
+
+#[cfg(feature = "alloc")]
+mod dynamic {
+    use super::{
+        Accelerations, DynFreePendulum, Dynamic, EnergyTerms, EquationsOfMotion, Forces, Mechanism,
+        Names, Outputs, ParameterError, Q, Unit, Vector, Velocities,
+    };
+    use mechgen_runtime::Matrix;
+    use mechgen_runtime::nalgebra::{Dyn, Matrix3};
+
+    fn fixed(v: &Vector<Dyn>) -> Q {
+        Q::from_iterator(v.iter().copied())
+    }
+
+    /// Runs `f` on the fixed-size pendulum and copies its vector result into `out`.
+    fn into(out: &mut Vector<Dyn>, f: impl FnOnce(&mut Q)) {
+        let mut result = Q::zeros();
+        f(&mut result);
+        out.copy_from_slice(result.as_slice());
+    }
+
+    impl Mechanism for DynFreePendulum {
+        type Dim = Dyn;
+        type Markers = [f64; 0];
+
+        fn names(&self) -> &'static Names {
+            self.0.names()
+        }
+        fn dim(&self) -> Dyn {
+            Dyn(3)
+        }
+        fn marker_storage(&self) -> [f64; 0] {
+            []
+        }
+        fn coordinate_name(&self, index: usize) -> Option<&str> {
+            self.0.coordinate_name(index)
+        }
+        fn equation_name(&self, index: usize) -> Option<&str> {
+            self.0.equation_name(index)
+        }
+        fn parameter_count(&self) -> usize {
+            0
+        }
+        fn parameter_name(&self, _: usize) -> Option<&str> {
+            None
+        }
+        fn parameter(&self, _: usize) -> Option<f64> {
+            None
+        }
+        fn set_parameter<'a>(
+            &'a mut self,
+            name: &'a str,
+            _: f64,
+        ) -> Result<(), ParameterError<'a>> {
+            Err(ParameterError::Unknown {
+                name,
+                declared: &[] as &[&str; 0],
+            })
+        }
+        fn coordinate_unit(&self, index: usize) -> Unit {
+            self.0.coordinate_unit(index)
+        }
+        fn equation_unit(&self, index: usize) -> Unit {
+            self.0.equation_unit(index)
+        }
+        fn length_scale(&self) -> f64 {
+            self.0.length_scale()
+        }
+        fn initial_guess(&self, q: &mut Vector<Dyn>) {
+            into(q, |out| self.0.initial_guess(out));
+        }
+        fn phi(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
+            into(out, |out| self.0.phi(&fixed(q), t, out));
+        }
+        fn jacobian(&self, q: &Vector<Dyn>, t: f64, out: &mut Matrix<Dyn>) {
+            let mut jacobian = Matrix3::zeros();
+            self.0.jacobian(&fixed(q), t, &mut jacobian);
+            out.copy_from(&jacobian);
+        }
+        fn outputs(&self) -> Outputs {
+            Outputs::Forces
+        }
+        fn nu(&self, q: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
+            into(out, |out| self.0.nu(&fixed(q), t, out));
+        }
+        fn gamma(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, t: f64, out: &mut Vector<Dyn>) {
+            into(out, |out| self.0.gamma(&fixed(q), &fixed(qd), t, out));
+        }
+        fn generalized_forces(
+            &self,
+            q: &Vector<Dyn>,
+            qd: &Vector<Dyn>,
+            qdd: &Vector<Dyn>,
+            t: f64,
+            out: &mut Vector<Dyn>,
+        ) {
+            into(out, |out| {
+                self.0
+                    .generalized_forces(&fixed(q), &fixed(qd), &fixed(qdd), t, out)
+            });
+        }
+        fn reactions(
+            &self,
+            q: &Vector<Dyn>,
+            qd: &Vector<Dyn>,
+            lambda: &[f64],
+            out: &mut Vector<Dyn>,
+        ) {
+            into(out, |out| {
+                self.0.reactions(&fixed(q), &fixed(qd), lambda, out)
+            });
+        }
+    }
+
+    impl Velocities for DynFreePendulum {}
+    impl Accelerations for DynFreePendulum {}
+    impl Forces for DynFreePendulum {}
+
+    impl EquationsOfMotion for DynFreePendulum {
+        fn mass_times(&self, q: &Vector<Dyn>, v: &Vector<Dyn>, out: &mut Vector<Dyn>) {
+            into(out, |out| self.0.mass_times(&fixed(q), &fixed(v), out));
+        }
+        fn damping_times(
+            &self,
+            q: &Vector<Dyn>,
+            qd: &Vector<Dyn>,
+            t: f64,
+            v: &Vector<Dyn>,
+            out: &mut Vector<Dyn>,
+        ) -> bool {
+            let mut has = false;
+            into(out, |out| {
+                has = self
+                    .0
+                    .damping_times(&fixed(q), &fixed(qd), t, &fixed(v), out);
+            });
+            has
+        }
+        fn energy_terms(&self, q: &Vector<Dyn>, qd: &Vector<Dyn>, t: f64) -> EnergyTerms {
+            self.0.energy_terms(&fixed(q), &fixed(qd), t)
+        }
+    }
+
+    impl Dynamic for DynFreePendulum {
+        type Free = Dyn;
+
+        fn free(&self) -> Dyn {
+            Dyn(1)
+        }
+        fn free_name(&self, k: usize) -> Option<&str> {
+            self.0.free_name(k)
+        }
+        fn free_equation(&self, k: usize) -> usize {
+            self.0.free_equation(k)
+        }
+        fn free_initial(&self, k: usize) -> (Option<f64>, f64) {
+            self.0.free_initial(k)
+        }
+        fn free_state(&self, k: usize) -> [f64; 3] {
+            self.0.free_state(k)
+        }
+        fn set_free(&mut self, k: usize, state: [f64; 3]) {
+            self.0.set_free(k, state);
+        }
+    }
+}
