@@ -272,7 +272,8 @@ fn stiff_sliders(h: f64, excite: f64) -> (Sliders, [f64; 2], f64) {
 
 #[test]
 fn a_stiff_spring_neither_blows_up_nor_needs_a_small_step() {
-    let t_end = 1.0;
+    // Not a whole slow period: at its extremes the phase error shows only at second order.
+    let t_end = 0.8;
     for rho in [1.0, 0.8, 0.0] {
         let mut errors = vec![];
         for h in [0.02, 0.01, 0.005] {
@@ -290,10 +291,16 @@ fn a_stiff_spring_neither_blows_up_nor_needs_a_small_step() {
             eprintln!("ρ∞ = {rho}, h = {h}: {:?}", integrator.stats());
             // Linear: the prediction is the answer, which the second evaluation confirms.
             let stats = integrator.stats();
-            assert!(stats.iterations <= 2 * stats.steps + 2, "{stats:?}");
+            assert!(10 * stats.iterations <= 21 * stats.steps, "{stats:?}");
         }
         eprintln!("stiff ρ∞ = {rho}: errors {errors:?}");
-        assert!(errors[0] < 2e-3 && errors[1] < errors[0] / 3.0 && errors[2] < errors[1] / 3.0);
+        // Second order (÷ 4 per halving) on the slow mode, amplitude 0.1, the fast one
+        // 1000 × beyond the middle step.
+        let amplitude = 0.1;
+        assert!(errors[0] < 0.05 * amplitude, "{errors:?}");
+        for pair in errors.windows(2) {
+            assert!((3.5..4.5).contains(&(pair[0] / pair[1])), "{errors:?}");
+        }
     }
 }
 
