@@ -10,6 +10,7 @@ mod common;
 use common::cart_pendulum::CartPendulum;
 use common::double_pendulum::DoublePendulum;
 use common::free_pendulum::FreePendulum;
+use common::free_slider_crank::FreeSliderCrank;
 use common::scene::Scene;
 use common::sliders::Sliders;
 use core::f64::consts::{FRAC_PI_2, PI};
@@ -883,5 +884,64 @@ fn a_dyn_scene_steps_exactly_as_the_fixed_size_one() {
         }
         assert_eq!(fixed_size.energy(), dynamic.energy());
         assert_eq!(fixed_size.stats(), dynamic.stats());
+    }
+}
+
+/// `(θ, θ̇)` of the free slider-crank at `t` from rest, by RK4 with steps of 1e-4.
+fn crank_reference(p: &FreeSliderCrank, t: f64) -> (f64, f64) {
+    let n = (t / 1e-4).ceil() as usize;
+    let h = t / n as f64;
+    let f = |y: [f64; 2]| [y[1], p.theta_ddot(y[0], y[1])];
+    let mut y = [p.theta0, 0.0];
+    for _ in 0..n {
+        let k1 = f(y);
+        let k2 = f(core::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
+        let k3 = f(core::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
+        let k4 = f(core::array::from_fn(|i| y[i] + h * k3[i]));
+        y = core::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+    }
+    (y[0], y[1])
+}
+
+/// The seed's shape: a slider-crank with its crank free under gravity and a spring on the
+/// slider, against its reduced one-coordinate equation from the closed-form kinematics; second
+/// order in fixed steps (its energy error too), within the tolerance in the error-controlled
+/// mode, the crank angle's effort zero.
+#[test]
+fn a_free_slider_crank_follows_its_reduced_equation() {
+    let p = FreeSliderCrank::default();
+    let t_end = 1.5;
+    let (theta, rate) = crank_reference(&p, t_end);
+    let run = |options: IntegratorOptions| {
+        let mut integrator =
+            Integrator::new(Solver::new(Scene::new(p.clone())), 0.0, options).unwrap();
+        let e0 = integrator.energy().total();
+        integrator.step_to(t_end).unwrap();
+        let [u, ud, _] = integrator.free_state(0);
+        let effort = integrator.constraint_forces().unwrap()[2];
+        let drift = (integrator.energy().total() - e0).abs();
+        (
+            (u - theta).abs(),
+            (ud - rate).abs(),
+            effort,
+            drift,
+            integrator.stats(),
+        )
+    };
+    let coarse = run(fixed(0.9, 0.01));
+    let fine = run(fixed(0.9, 0.005));
+    let controlled = run(adaptive(0.9, 1e-7, 1e-10));
+    eprintln!("slider-crank: θ(1.5) = {theta:.6}; fixed 0.01 {coarse:?}");
+    eprintln!("  fixed 0.005 {fine:?}");
+    eprintln!("  rtol 1e-7 {controlled:?}");
+    assert!(
+        (3.5..4.5).contains(&(coarse.0 / fine.0)),
+        "{coarse:?} {fine:?}"
+    );
+    assert!(controlled.0 < 15.0 * 1e-7 * t_end && controlled.1 < 1e-4);
+    // The energy error is the method's, second order too.
+    assert!((3.5..4.5).contains(&(coarse.3 / fine.3)) && controlled.3 < 1e-5);
+    for (_, _, effort, _, _) in [coarse, fine, controlled] {
+        assert!(effort.abs() < 1e-8, "{effort}");
     }
 }
