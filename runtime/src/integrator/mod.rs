@@ -119,7 +119,7 @@ where
                 value: t0,
             });
         }
-        let initial = initial_motion(&mut solver);
+        let (initial, slopes) = initial_motion(&mut solver);
         if let Some(k) = initial.first_non_finite() {
             return Err(DynamicsError::NonFinite {
                 t: t0,
@@ -128,17 +128,17 @@ where
             });
         }
         let (state, solver) = assemble(solver, &initial, t0)?;
-        let mut integrator = Self::with_state(solver, state, initial, options);
+        let mut integrator = Self::with_state(solver, state, (initial, &slopes), options);
         integrator.restart()?;
         Ok(integrator)
     }
 
     /// The integrator's storage around an assembled `state` with free coordinates `initial`
-    /// (accelerations not yet solved).
+    /// (accelerations not yet solved) and free equations of slopes `slopes`.
     fn with_state(
         solver: Solver<M>,
         state: State<M>,
-        initial: FreeMotion<M::Free>,
+        (initial, slopes): (FreeMotion<M::Free>, &OVector<f64, M::Free>),
         options: IntegratorOptions,
     ) -> Self {
         let m = solver.mechanism();
@@ -158,7 +158,7 @@ where
             state,
             now: initial.clone(),
             next: initial,
-            reduced: Reduced::new(m),
+            reduced: Reduced::new(m, slopes),
             matrix,
             correction: OVector::zeros_generic(f, U1),
             earlier: OVector::zeros_generic(f, U1),
@@ -188,7 +188,8 @@ where
             .and_then(|_| {
                 self.next.udd += &self.correction;
                 self.evaluate(t)
-            });
+            })
+            .and_then(|()| self.solve_v());
         self.matrix.step = None;
         solved.map_err(|failure| self.failure(failure, t, 0.0))?;
         self.next.a.copy_from(&self.next.udd);
@@ -197,6 +198,7 @@ where
         core::mem::swap(&mut self.state, &mut self.trial);
         core::mem::swap(&mut self.now, &mut self.next);
         let m = self.solver.mechanism();
+        self.reduced.measure_forces(m, &self.state);
         self.book.restart(m, &self.state, &self.reduced.forces);
         Ok(())
     }
@@ -403,17 +405,21 @@ where
     Ok((state, simulation.into_solver()))
 }
 
-/// The declared initial values and rates of the free degrees of freedom; a value not declared
-/// is the driven quantity at the scene's `near` guesses: the free equation `g(q) − u` is
-/// affine in `u`, so two evaluations of Φ at the guess (u = 0 and u = 1) give the `u` that
-/// zeroes it, whatever the equation's sign convention.
-fn initial_motion<M: Dynamic + Structured>(solver: &mut Solver<M>) -> FreeMotion<M::Free>
+/// The declared initial values and rates of the free degrees of freedom, and each free
+/// equation's slope `∂Φ_e/∂u`; a value not declared is the driven quantity at the scene's
+/// `near` guesses: the free equation `g(q) − u` is affine in `u`, so two evaluations of Φ at
+/// the guess (u = 0 and u = 1) give the slope and the `u` that zeroes it, whatever the
+/// equation's sign convention.
+fn initial_motion<M: Dynamic + Structured>(
+    solver: &mut Solver<M>,
+) -> (FreeMotion<M::Free>, OVector<f64, M::Free>)
 where
     DefaultAllocator: Storage<M::Dim> + FreeStorage<M::Dim, M::Free>,
 {
     let m = solver.mechanism_mut();
     let (n, f) = (m.dim(), m.free());
     let mut motion = FreeMotion::new(f);
+    let mut slopes = OVector::zeros_generic(f, U1);
     let mut guess = Vector::zeros_generic(n, U1);
     m.initial_guess(&mut guess);
     let mut phi = [Vector::zeros_generic(n, U1), Vector::zeros_generic(n, U1)];
@@ -428,8 +434,9 @@ where
         let e = m.free_equation(k);
         let at = |v: &Vector<M::Dim>| v.get(e).copied().unwrap_or(f64::NAN);
         let (p0, p1) = (at(&phi[0]), at(&phi[1]));
+        slopes[k] = p1 - p0;
         motion.u[k] = declared.unwrap_or(-p0 / (p1 - p0));
         motion.ud[k] = rate;
     }
-    motion
+    (motion, slopes)
 }

@@ -233,9 +233,11 @@ where
             self.stats.iterations += 1;
             self.next.advance(&self.now, &self.alpha, h);
             self.evaluate(t)?;
+            // Whether V is this iterate's (a refresh solves for it).
+            let mut solved_v = false;
             if self.matrix.step != Some(h) || !self.matrix.built {
                 self.refresh(h)?;
-                fresh = true;
+                (fresh, solved_v) = (true, true);
             } else if iteration > 1 && previous > UPDATE_ABOVE * tolerance {
                 self.matrix.update(&self.correction, &self.reduced.residual);
             }
@@ -243,14 +245,14 @@ where
             if size > CONTRACTION * previous && !fresh {
                 // Slow: the kept matrix is too far from this iterate's; rebuild it here.
                 self.refresh(h)?;
-                fresh = true;
+                (fresh, solved_v) = (true, true);
                 size = self.correct(h)?;
             }
             // Converged; or, with a fresh matrix, stalled at the residual's round-off (a stiff
             // spring amplifies the positions' rounding into forces) within reach of it.
             let stalled = fresh && size > CONTRACTION * previous && size <= STALL * tolerance;
             if size <= tolerance || stalled {
-                return self.check_crossing();
+                return self.finish(solved_v);
             }
             if size >= previous && fresh {
                 return Err(Failure::NoConvergence {
@@ -322,6 +324,25 @@ where
         self.next.advance(&self.now, &self.alpha, h);
     }
 
+    /// Completes the converged iterate in `trial`: its `V` (unless `solved_v`) and `F`, then
+    /// the toggle check.
+    fn finish(&mut self, solved_v: bool) -> Result<(), Failure> {
+        if !solved_v {
+            self.solve_v()?;
+        }
+        let m = self.solver.mechanism();
+        self.reduced.measure_forces(m, &self.trial);
+        self.check_crossing()
+    }
+
+    /// `V` at the last evaluation (`next`, solved into `trial`).
+    pub(super) fn solve_v(&mut self) -> Result<(), Failure> {
+        let t = self.trial.t;
+        self.reduced
+            .sensitivities(&mut self.solver, t, &self.next, &self.trial)
+            .map_err(Failure::Kinematics)
+    }
+
     /// The converged state is on the same side of every singular configuration as the
     /// current one (the sign of det Φ_q and of each block's determinant): otherwise the free
     /// motion crossed a toggle of its partition, where the kinematic solve lands on the
@@ -360,6 +381,7 @@ where
     /// Rebuilds the iteration matrix's parts at the last evaluation and inverts it for step
     /// `h` (`h = 0`: the reduced mass alone, for the accelerations of a state).
     pub(super) fn refresh(&mut self, h: f64) -> Result<(), Failure> {
+        self.solve_v()?;
         let m = self.solver.mechanism();
         let it = &mut self.matrix;
         it.built = false;

@@ -1,11 +1,15 @@
 //! One evaluation of the reduced equations of motion at a free state `(t, u, u̇, ü)`: the
 //! free degrees of freedom set, the structured kinematic solve (`q`, `q̇`, `q̈` with the
-//! constraints exact), the sensitivities `V = ∂q/∂u`, the generalised forces
-//! `F = Q − M q̈` and the residual `R = Vᵀ F`; and, on demand, the reduced matrices `VᵀMV`,
-//! `VᵀCV`, `VᵀKV` the iteration matrix is built from.
+//! constraints exact, and the force solve's multipliers λ), and the residual `R = Vᵀ F`,
+//! `V = ∂q/∂u`, `F = Q − M q̈`; and, on demand, `V` itself (one velocity solve per free degree
+//! of freedom), `F`, and the reduced matrices `VᵀMV`, `VᵀCV`, `VᵀKV` of the iteration matrix.
 //!
-//! `R` is the effort the free degrees of freedom's equations carry (`Φ_q V = I` on their rows,
-//! so `Vᵀ Φ_qᵀ λ = λ_free`): zero on a solved motion, which is the equation of motion.
+//! `R` is the effort the free degrees of freedom's equations carry, read from the force
+//! solve: `F = Φ_qᵀ λ` (Φ_q is square), and the free rows `g(q) − u` give `Φ_q V = e_k`
+//! (differentiating `Φ(q(u), u) = 0`), so `R_k = V_kᵀ Φ_qᵀ λ = λ_{e_k}` — times the sign of
+//! `−∂Φ_{e_k}/∂u_k` for a scene that writes the row the other way round. An evaluation
+//! therefore costs one structured solve; `V` is solved for only where it is needed (the
+//! iteration matrix, the accepted state).
 
 use nalgebra::{DefaultAllocator, OMatrix, OVector, U1};
 
@@ -22,12 +26,15 @@ pub(crate) struct Reduced<M: Dynamic>
 where
     DefaultAllocator: Storage<M::Dim> + FreeStorage<M::Dim, M::Free>,
 {
-    /// `V = ∂q/∂u`, one column per free degree of freedom.
+    /// `V = ∂q/∂u`, one column per free degree of freedom, where last solved for.
     pub v: OMatrix<f64, M::Dim, M::Free>,
-    /// `F = Q − M q̈` at the evaluated state.
+    /// `F = Q − M q̈`, where last computed.
     pub forces: Vector<M::Dim>,
-    /// `R = Vᵀ F`.
+    /// `R = Vᵀ F` at the last evaluation.
     pub residual: OVector<f64, M::Free>,
+    /// Each free degree of freedom's equation and the sign of `−∂Φ_e/∂u` there.
+    rows: OVector<usize, M::Free>,
+    signs: OVector<f64, M::Free>,
     /// Scratch: a column of `V`, its product with `M`, `K` or `C`, a velocity solve.
     column: Vector<M::Dim>,
     product: Vector<M::Dim>,
@@ -49,24 +56,26 @@ impl<M: Dynamic + EquationsOfMotion + Structured> Reduced<M>
 where
     DefaultAllocator: Storage<M::Dim> + FreeStorage<M::Dim, M::Free>,
 {
-    /// Storage for `m`.
-    pub fn new(m: &M) -> Self {
+    /// Storage for `m`, whose free rows have `∂Φ_e/∂u = slopes` (−1 for `g(q) − u`).
+    pub fn new(m: &M, slopes: &OVector<f64, M::Free>) -> Self {
         let (n, f) = (m.dim(), m.free());
         Self {
             v: OMatrix::zeros_generic(n, f),
             forces: Vector::zeros_generic(n, U1),
             residual: OVector::zeros_generic(f, U1),
+            rows: OVector::from_fn_generic(f, U1, |k, _| m.free_equation(k)),
+            signs: slopes.map(|slope| if slope > 0.0 { -1.0 } else { 1.0 }),
             column: Vector::zeros_generic(n, U1),
             product: Vector::zeros_generic(n, U1),
             velocity: Vector::zeros_generic(n, U1),
         }
     }
 
-    /// Evaluates at `(t, x)`, solving the kinematics into `state` from the positions it holds
-    /// (the warm start).
+    /// Evaluates `R` at `(t, x)`, solving the kinematics into `state` from the positions it
+    /// holds (the warm start).
     ///
     /// # Errors
-    /// The kinematic solve's error, of the positions or of a sensitivity's velocity solve.
+    /// The kinematic solve's error.
     pub fn evaluate(
         &mut self,
         solver: &mut Solver<M>,
@@ -76,22 +85,32 @@ where
     ) -> Result<(), SolveError> {
         set_free(solver, x);
         solver.solve_into(t, state)?;
-        self.sensitivities(solver, t, x, state)?;
-        solver.mechanism().generalized_forces(
+        let lambda = solver.multipliers();
+        for k in 0..self.residual.len() {
+            let row = lambda.get(self.rows[k]).copied().unwrap_or(f64::NAN);
+            self.residual[k] = self.signs[k] * row;
+        }
+        Ok(())
+    }
+
+    /// `F` at the evaluated `state`.
+    pub fn measure_forces(&mut self, m: &M, state: &State<M>) {
+        m.generalized_forces(
             &state.q,
             &state.velocities,
             &state.accelerations,
-            t,
+            state.t,
             &mut self.forces,
         );
-        self.residual.gemv_tr(1.0, &self.v, &self.forces, 0.0);
-        Ok(())
     }
 
     /// `V`, column by column: q̇ is affine in u̇ at fixed positions, so column k is the change
     /// of q̇ when u̇_k alone changes, divided by the change (one velocity solve each). The
     /// change is `1 + |u̇_k|`, so that the difference keeps the digits of a fast motion.
-    fn sensitivities(
+    ///
+    /// # Errors
+    /// A velocity solve's error.
+    pub fn sensitivities(
         &mut self,
         solver: &mut Solver<M>,
         t: f64,
