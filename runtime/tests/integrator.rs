@@ -945,3 +945,58 @@ fn a_free_slider_crank_follows_its_reduced_equation() {
         assert!(effort.abs() < 1e-8, "{effort}");
     }
 }
+
+/// A stiff spring in a linkage: the free slider-crank's slider on a spring whose period
+/// through the linkage is some 400× shorter than the step (k = 6e11, h = 1e-2), preloaded by
+/// 1 µm, over 1 s. With ρ∞ = 1 the fast oscillation it excites keeps its amplitude (the slider within
+/// about twice the preload); with ρ∞ < 1 it is damped out and the crank settles on the static
+/// equilibrium of the reduced equation (`θ̈(θ, 0) = 0`, solved here by the secant method).
+#[test]
+fn a_stiff_spring_in_a_linkage_settles_on_its_equilibrium() {
+    let mut p = FreeSliderCrank::default();
+    let x_start = {
+        let integrator =
+            Integrator::new(Solver::new(Scene::new(p.clone())), 0.0, fixed(1.0, 0.01)).unwrap();
+        integrator.state().q[6]
+    };
+    let preload = 1e-6;
+    p.spring = (6e11, x_start + preload);
+    // The static equilibrium: θ̈(θ, 0) = 0 near θ0.
+    let (mut a, mut b) = (p.theta0, p.theta0 - 1e-5);
+    for _ in 0..50 {
+        let (fa, fb) = (p.theta_ddot(a, 0.0), p.theta_ddot(b, 0.0));
+        if fb == fa {
+            break;
+        }
+        (a, b) = (b, b - fb * (b - a) / (fb - fa));
+    }
+    let equilibrium = b;
+    for rho in [1.0, 0.8, 0.0] {
+        let mut integrator =
+            Integrator::new(Solver::new(Scene::new(p.clone())), 0.0, fixed(rho, 0.01)).unwrap();
+        let mut range = (f64::MAX, f64::MIN);
+        integrator
+            .run(1.0, |state, _| {
+                let x = state.q[6] - x_start;
+                range = (range.0.min(x), range.1.max(x));
+            })
+            .unwrap();
+        let theta = integrator.free_state(0)[0];
+        eprintln!(
+            "stiff linkage ρ∞ = {rho}: θ − θ_eq = {:.1e}, slider moved {:.2e}..{:.2e}, {:?}",
+            theta - equilibrium,
+            range.0,
+            range.1,
+            integrator.stats()
+        );
+        // Twice the preload (an undamped swing about the preloaded equilibrium), and the
+        // little gravity adds.
+        assert!(range.0 > -1e-9 && range.1 < 2.01 * preload, "{range:?}");
+        if rho < 1.0 {
+            assert!(
+                (theta - equilibrium).abs() < 1e-9,
+                "{theta} vs {equilibrium}"
+            );
+        }
+    }
+}
