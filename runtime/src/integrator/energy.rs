@@ -16,6 +16,7 @@ use crate::state::State;
 
 /// The energies at the integrator's state and the works done since its start (scene units:
 /// with kg, mm and s, energies are in kg·mm²/s² = µJ).
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Energy {
     /// Kinetic energy `½ q̇ᵀ M q̇`.

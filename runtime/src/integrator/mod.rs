@@ -45,6 +45,7 @@ use crate::state::State;
 use crate::structure::Structured;
 
 /// The integrator's work so far.
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct IntegratorStats {
     /// Accepted steps.
