@@ -1000,3 +1000,20 @@ fn a_stiff_spring_in_a_linkage_settles_on_its_equilibrium() {
         }
     }
 }
+
+/// A free state the kinematics cannot reach (x beyond the rod's length) is refused with the
+/// kinematic error, and the integrator goes on from the state it had.
+#[test]
+fn an_unreachable_free_state_leaves_the_integrator_as_it_was() {
+    let mut p = FreePendulum::released(-2.0, 0.0);
+    p.free_x = true;
+    p.initial = (Some(p.length * (-2.0_f64).cos()), 0.0);
+    let mut integrator = pendulum(p.clone(), fixed(0.9, 0.01));
+    integrator.step_to(0.1).unwrap();
+    let (q, free) = (integrator.state().q, integrator.free_state(0));
+    let error = integrator.set_free(0, 2.0 * p.length, 0.0).unwrap_err();
+    assert!(matches!(error, DynamicsError::Solve { .. }), "{error}");
+    assert_eq!((integrator.state().q, integrator.free_state(0)), (q, free));
+    integrator.step_to(0.2).unwrap();
+    assert!(integrator.state().q.iter().all(|x| x.is_finite()));
+}

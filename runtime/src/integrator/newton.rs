@@ -300,6 +300,10 @@ where
         self.trial
             .q
             .gemv(1.0, &self.reduced.v, &self.correction, 1.0);
+        if self.trial.q.iter().any(|x| !x.is_finite()) {
+            // A V left by a failed restart elsewhere: start from the positions as they are.
+            self.trial.q.copy_from(&self.state.q);
+        }
         Ok(())
     }
 
