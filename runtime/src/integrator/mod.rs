@@ -52,8 +52,9 @@ pub struct IntegratorStats {
     pub steps: usize,
     /// Rejected step attempts (error too large, or an iteration that failed).
     pub rejected: usize,
-    /// Newton iterations (each one evaluation of the reduced equations: a kinematic solve and
-    /// one velocity solve per free degree of freedom).
+    /// Newton iterations, each one evaluation of the reduced equations: a structured solve
+    /// (positions, rates and the force solve). Each accepted step, and each rebuild of the
+    /// iteration matrix, adds one velocity solve per free degree of freedom (for `∂q/∂u`).
     pub iterations: usize,
     /// Factorisations of the iteration matrix.
     pub factorizations: usize,
