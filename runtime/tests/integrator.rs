@@ -1017,3 +1017,17 @@ fn an_unreachable_free_state_leaves_the_integrator_as_it_was() {
     integrator.step_to(0.2).unwrap();
     assert!(integrator.state().q.iter().all(|x| x.is_finite()));
 }
+
+/// A clone is a checkpoint: stepped on, it gives bit for bit what the original gives.
+#[test]
+fn a_clone_continues_exactly_as_the_original() {
+    let mut original = pendulum(FreePendulum::released(-0.9, 0.4), adaptive(0.9, 1e-6, 1e-9));
+    original.step_to(0.5).unwrap();
+    let mut copy = original.clone();
+    original.step_to(1.5).unwrap();
+    copy.step_to(1.5).unwrap();
+    assert_eq!(original.free_state(0), copy.free_state(0));
+    assert_eq!(original.state().q, copy.state().q);
+    assert_eq!(original.energy(), copy.energy());
+    assert_eq!(original.stats(), copy.stats());
+}

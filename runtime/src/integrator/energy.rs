@@ -53,6 +53,19 @@ where
     scratch: Vector<M::Dim>,
 }
 
+impl<M: Mechanism> Clone for Book<M>
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    fn clone(&self) -> Self {
+        Self {
+            energy: self.energy,
+            powers: self.powers,
+            scratch: self.scratch.clone(),
+        }
+    }
+}
+
 /// Powers of the loads, of the dampers (dissipated) and of the drivers.
 #[derive(Debug, Clone, Copy, Default)]
 struct Powers {

@@ -95,6 +95,35 @@ where
     stats: IntegratorStats,
 }
 
+/// A checkpoint: the copy continues from the same state, with the same history (its iteration
+/// matrix, step size, energy book and statistics).
+impl<M: Dynamic + EquationsOfMotion + Structured + Clone> Clone for Integrator<M>
+where
+    M::Workspace: Clone,
+    DefaultAllocator: Storage<M::Dim> + FreeStorage<M::Dim, M::Free>,
+{
+    fn clone(&self) -> Self {
+        Self {
+            solver: self.solver.clone(),
+            state: self.state.clone(),
+            trial: self.trial.clone(),
+            now: self.now.clone(),
+            next: self.next.clone(),
+            reduced: self.reduced.clone(),
+            matrix: self.matrix.clone(),
+            correction: self.correction.clone(),
+            earlier: self.earlier.clone(),
+            earlier_step: self.earlier_step,
+            alpha: self.alpha,
+            options: self.options,
+            step: self.step,
+            sensitivity: self.sensitivity,
+            book: self.book.clone(),
+            stats: self.stats,
+        }
+    }
+}
+
 impl<M: Dynamic + EquationsOfMotion + Structured> Integrator<M>
 where
     DefaultAllocator: Storage<M::Dim> + FreeStorage<M::Dim, M::Free>,

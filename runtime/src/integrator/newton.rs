@@ -65,6 +65,7 @@ pub(crate) enum Failure {
 }
 
 /// The iteration matrix's reduced parts, its inverse and the step size it is for.
+#[derive(Clone)]
 pub(crate) struct IterationMatrix<F: Dim>
 where
     DefaultAllocator: Storage<F>,

@@ -41,6 +41,24 @@ where
     velocity: Vector<M::Dim>,
 }
 
+impl<M: Dynamic> Clone for Reduced<M>
+where
+    DefaultAllocator: Storage<M::Dim> + FreeStorage<M::Dim, M::Free>,
+{
+    fn clone(&self) -> Self {
+        Self {
+            v: self.v.clone(),
+            forces: self.forces.clone(),
+            residual: self.residual.clone(),
+            rows: self.rows.clone(),
+            signs: self.signs.clone(),
+            column: self.column.clone(),
+            product: self.product.clone(),
+            velocity: self.velocity.clone(),
+        }
+    }
+}
+
 /// Writes `[u, u̇, ü]` of every free degree of freedom into the mechanism.
 pub(crate) fn set_free<M: Dynamic + Structured>(solver: &mut Solver<M>, x: &FreeMotion<M::Free>)
 where

@@ -27,6 +27,15 @@ where
     }
 }
 
+impl<S: Mechanism + Clone> Clone for Scene<S>
+where
+    DefaultAllocator: Storage<S::Dim>,
+{
+    fn clone(&self) -> Self {
+        Self(self.0.clone())
+    }
+}
+
 impl<S: Mechanism> Mechanism for Scene<S>
 where
     DefaultAllocator: Storage<S::Dim>,
