@@ -18,8 +18,12 @@ use crate::mechanism::{Forces, Storage, Vector};
 
 /// Storage bounds for a scene with `D` coordinates and `F` free degrees of freedom; repeat
 /// this where-clause on generic code (it holds for every `Const` pair and, with `alloc`, `Dyn`).
-pub trait FreeStorage<D: Dim, F: Dim>: Allocator<F> + Allocator<F, F> + Allocator<D, F> {}
-impl<D: Dim, F: Dim, A: Allocator<F> + Allocator<F, F> + Allocator<D, F>> FreeStorage<D, F> for A {}
+///
+/// It names [`Storage<F>`] (not its two allocators) so that generic code with both bounds
+/// holds two `Storage` where-clauses and rustc infers which dimension a value has from the
+/// value, not from the only where-clause in sight.
+pub trait FreeStorage<D: Dim, F: Dim>: Storage<F> + Allocator<D, F> {}
+impl<D: Dim, F: Dim, A: Storage<F> + Allocator<D, F>> FreeStorage<D, F> for A {}
 
 /// The conservative energies and the powers at one state, from [`EquationsOfMotion::energy_terms`]
 /// (the kinetic energy is `½ q̇ᵀ M q̇`, from [`EquationsOfMotion::mass_times`]).

@@ -9,7 +9,8 @@
 //! ([`Structured`]): explicit assignments and small Newton blocks in dependency order, each
 //! block's sparse factorisation fixed at generation time. [`Solver`] solves one instant
 //! ([`Solver::solve`]); [`Simulation`] steps through time with a warm-started predictor;
-//! [`Dense`] solves any mechanism as one dense block (the reference). Failures are
+//! [`Dense`] solves any mechanism as one dense block (the reference); [`Integrator`] moves a
+//! scene's free degrees of freedom under its forces (forward dynamics, [`Dynamic`]). Failures are
 //! [`SolveError`]s, which name the scene's equations, coordinates, branches and parameters
 //! ([`Names`]).
 //! [`State::write_csv_row`] writes results without a heap.
@@ -73,6 +74,7 @@ mod error;
 mod finite;
 mod forces;
 mod geometry;
+mod integrator;
 mod lu;
 mod markers;
 mod mechanism;
@@ -93,6 +95,10 @@ pub use dense::Dense;
 pub use dynamic::{Dynamic, EnergyTerms, EquationsOfMotion, FreeStorage};
 pub use error::{Described, Quantity, SolveError};
 pub use geometry::{GeometryFault, MAX_LENGTH, Requirement};
+pub use integrator::{
+    DescribedDynamics, DynamicsError, Energy, Integrator, IntegratorOptions, IntegratorStats,
+    StepControl,
+};
 pub use lu::{DEFAULT_PIVOT_TOLERANCE, Lu, LuError};
 pub use markers::{
     AnglePosition, AngleState, AngleVelocity, PointPosition, PointState, PointVelocity,

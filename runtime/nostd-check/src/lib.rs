@@ -6,6 +6,8 @@ use core::fmt::{self, Write};
 
 use mechgen_runtime::{Simulation, Solver, mechanism, write_csv_header};
 
+mod free;
+
 // Generated code, not a hand-written mechanism: this proves that what `mechanism!` emits (math
 // shim, fixed-size storage, no std paths) links without std or alloc. The scene uses every joint
 // kind, a time-varying driver, a branch invariant, and mass properties, gravity and every load
@@ -68,6 +70,9 @@ pub extern "C" fn mechgen_nostd_check(t_end: f64, steps: u32) -> usize {
 /// `#[no_mangle]`, which needs `unsafe` syntax in edition 2024, nothing else references it.
 #[used]
 static ENTRY: extern "C" fn(f64, u32) -> usize = mechgen_nostd_check;
+/// The integrator's entry point, kept likewise.
+#[used]
+static INTEGRATE: extern "C" fn(f64) -> f64 = free::mechgen_nostd_integrate;
 
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {

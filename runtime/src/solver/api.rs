@@ -147,6 +147,15 @@ where
         columns.get(..self.diagnosed.1).unwrap_or(&[])
     }
 
+    /// After a solve of a scene that computes forces: the Lagrange multipliers λ of its force
+    /// solve (`Φ_qᵀ λ = F`), one per equation, as the workspace keeps them; empty for a scene
+    /// without forces.
+    pub(crate) fn multipliers(&mut self) -> &[f64] {
+        let n = nalgebra::Dim::value(&self.mechanism.dim());
+        let forces = self.workspace.parts().forces;
+        forces.get(..n).unwrap_or(&[])
+    }
+
     /// Displays `error` with the scene's names and, for the [`SolveError::Singular`] this
     /// solver just returned, every dependent equation and undetermined coordinate.
     pub fn describe<'a>(&'a self, error: &'a SolveError) -> Described<'a, M> {

@@ -34,7 +34,7 @@ impl Default for SliderCrank {
     }
 }
 
-const COORDINATES: [&str; 9] = [
+pub const COORDINATES: [&str; 9] = [
     "crank.x",
     "crank.y",
     "crank.theta",
@@ -45,7 +45,7 @@ const COORDINATES: [&str; 9] = [
     "slider.y",
     "slider.theta",
 ];
-const EQUATIONS: [&str; 9] = [
+pub const EQUATIONS: [&str; 9] = [
     "crank_pivot.x",
     "crank_pivot.y",
     "crank_drive",
