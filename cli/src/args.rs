@@ -34,7 +34,7 @@ Every time is written back in the `t` column in shortest round-trip form, bit fo
 #[command(
     name = "mechgen",
     version,
-    about = "Compile, inspect and solve planar mechanisms written in .mech files",
+    about = "Compile, inspect, solve and simulate planar mechanisms written in .mech files",
     after_help = EXIT_STATUS,
     arg_required_else_help = true,
     propagate_version = true
@@ -87,6 +87,21 @@ enum Sub {
     /// `reactions`, then the states.
     #[command(after_help = format!("{TIMES_HELP}\n\n{EXIT_STATUS}"))]
     Solve(SolveFlags),
+    /// Simulate the motion of a scene's free degrees of freedom under its forces (forward
+    /// dynamics) with the runtime's integrator, and write it as CSV or JSON
+    ///
+    /// The scene declares its free degrees of freedom where drivers would go (`free swing:
+    /// angle(arm) from 0.3 speed 0;`); the integrator (generalized-α on the equations reduced
+    /// to them, the constraints solved exactly at every step) chooses its steps by a local
+    /// error estimate (`--rtol`, `--atol`), or takes fixed ones (`--step H`), and lands exactly
+    /// on each sample time. CSV columns: those of `solve`, then `energy.kinetic`,
+    /// `energy.gravity`, `energy.springs`, `energy.loads_work`, `energy.drivers_work`,
+    /// `energy.dissipated` and `energy.total` (kinetic + potentials − work of loads and
+    /// drivers + dissipated: constant up to the integrator's error), then each free degree of
+    /// freedom's `NAME.value` and `NAME.rate`. JSON lists the same names under `energy` and
+    /// `free`, the values in each state, and the integrator's totals under `stats`.
+    #[command(after_help = format!("{TIMES_HELP}\n\n{EXIT_STATUS}"))]
+    Simulate(simulate::SimulateFlags),
     /// Print a completion script for a shell (e.g. `mechgen completions bash > mechgen.bash`)
     Completions {
         /// The shell
@@ -167,6 +182,8 @@ pub enum Command {
     },
     /// Solve a scene over time and write CSV.
     Solve(SolveArgs),
+    /// Simulate a scene's free motion and write CSV or JSON.
+    Simulate(simulate::SimulateArgs),
     /// Print a completion script.
     Completions(clap_complete::Shell),
 }
@@ -282,6 +299,7 @@ pub fn parse(args: impl IntoIterator<Item = OsString>) -> Result<Command, clap::
             run: run_args(flags.run, limits, "solve")?,
             diagnostics: flags.diagnostics,
         }),
+        Sub::Simulate(flags) => Command::Simulate(flags.resolve(limits)?),
     })
 }
 

@@ -1,6 +1,7 @@
-//! The `mechgen` command line (`expand`, `check`, `solve`, `completions`): a front end over
-//! `mechgen` and the interpreter (`mechgen_interp::Interpreted`), which runs `.mech` scenes
-//! through the runtime's solver. Here: arguments, reading scenes, the commands and their output.
+//! The `mechgen` command line (`expand`, `check`, `solve`, `simulate`, `completions`): a front
+//! end over `mechgen` and the interpreter (`mechgen_interp::Interpreted`), which runs `.mech`
+//! scenes through the runtime's solver and integrator. Here: arguments, reading scenes, the
+//! commands and their output.
 //!
 //! The binary is a thin wrapper around [`run`]; the pieces are public so that tests can reuse
 //! them. Equally spaced sample times come from [`mechgen_runtime::sample_time`], as
@@ -16,6 +17,7 @@ pub mod output;
 mod schedule;
 mod session;
 mod sets;
+mod simulate;
 mod solve;
 mod words;
 
@@ -93,6 +95,7 @@ fn execute(
             print(stdout, &text)
         }
         Command::Solve(args) => solve::solve(&args, stdout, stderr),
+        Command::Simulate(args) => simulate::simulate(&args, stdout, stderr),
     }
 }
 

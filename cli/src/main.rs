@@ -1,4 +1,5 @@
-//! The `mechgen` binary: `expand`, `check` and `solve` `.mech` scenes (see `mechgen --help`).
+//! The `mechgen` binary: `expand`, `check`, `solve` and `simulate` `.mech` scenes (see
+//! `mechgen --help`).
 
 use std::io::{self, Write};
 use std::process::ExitCode;

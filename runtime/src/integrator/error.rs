@@ -17,6 +17,7 @@ use crate::names::Names;
 /// equation (the row its `free` declaration adds, which the scene's [`Names`] name), and
 /// [`DynamicsError::describe`] by the name the scene gives it ([`Dynamic::free_name`]).
 #[derive(Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum DynamicsError {
     /// The kinematic solve failed at a step's iterate: no assembly, a toggle of the coordinate
     /// a free degree of freedom names (the partition is singular there: declare another
@@ -72,6 +73,7 @@ pub enum DynamicsError {
         /// Its equation (Φ order).
         equation: usize,
         /// The scene's names.
+        #[cfg_attr(feature = "serde", serde(skip))]
         names: &'static Names,
     },
     /// A free degree of freedom's state or its equation's residual became NaN or infinite.

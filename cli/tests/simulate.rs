@@ -64,7 +64,7 @@ fn a_small_swing_follows_the_harmonic_solution() {
     let theta0 = 0.01;
     let path = pendulum("harmonic.mech", theta0);
     let out = mechgen(&[
-        "simulate", &path, "--t-end", "1", "--steps", "20", "--rtol", "1e-9", "--atol", "1e-12",
+        "simulate", &path, "--t-end", "1", "--steps", "20", "--rtol", "1e-6", "--atol", "1e-9",
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let (header, rows) = csv_rows(&out);
