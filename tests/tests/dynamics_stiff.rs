@@ -126,7 +126,7 @@ fn a_millisecond_step_stays_bounded() {
 fn a_millisecond_step_is_generalized_alpha_on_the_reduced_equation() {
     // What the bounded run above does is the method's doing: its steps are those of
     // `reference::generalized_alpha` on the reduced equation with the stiff spring, to the
-    // solvers' tolerances (a thousandth of the excursion).
+    // integrator's Newton tolerance (1e-10 rad; measured: 3e-15 rad at ρ∞ = 0.5 and 0).
     let seed = reference();
     for rho_inf in [0.5, 0.0] {
         let mut reduced = GeneralizedAlpha::new(
@@ -137,15 +137,18 @@ fn a_millisecond_step_is_generalized_alpha_on_the_reduced_equation() {
             rho_inf,
         );
         let mut integrator = start(scene(&seed), fixed(1e-3, rho_inf));
+        let mut largest = 0.0f64;
         for n in 1..=100 {
             integrator.step().unwrap_or_else(|e| panic!("{e}"));
             reduced.step(1e-3).unwrap_or_else(|e| panic!("{e}"));
             let (u, v) = (integrator.free_state(0)[0], reduced.state()[0][0]);
+            largest = largest.max((u - v).abs());
             assert!(
-                (u - v).abs() <= 5e-9,
+                (u - v).abs() <= 1e-10,
                 "ρ∞ = {rho_inf}, step {n}: {u} vs {v}"
             );
         }
+        eprintln!("stiff seed, h = 1 ms, ρ∞ = {rho_inf}: {largest:.1e} rad from generalized-α");
     }
 }
 
