@@ -126,9 +126,11 @@ impl<const N: usize, F: Fn(f64, &[f64; N], &[f64; N]) -> [f64; N]> GeneralizedAl
     ///
     /// # Errors
     /// [`NewtonFailure`] if Newton (with a central-difference Jacobian) does not converge to
-    /// round-off of the accelerations, or the state turns non-finite; the state is then unchanged.
+    /// round-off of the accelerations (or, with a stiff force, stall at a correction that moves
+    /// the positions by round-off), or the state turns non-finite; the state is then unchanged.
     pub fn step(&mut self, h: f64) -> Result<(), NewtonFailure> {
         let mut x = self.accel;
+        let mut previous = f64::INFINITY;
         for _ in 0..MAX_NEWTON {
             let r = self.residual(&x, h);
             let dx = solve(self.jacobian(&x, h), r.map(|v| -v));
@@ -138,13 +140,22 @@ impl<const N: usize, F: Fn(f64, &[f64; N], &[f64; N]) -> [f64; N]> GeneralizedAl
                 .chain(&self.accel)
                 .chain(&self.a)
                 .fold(1.0f64, |m, v| m.max(v.abs()));
+            let correction = dx.iter().fold(0.0f64, |m, d| m.max(d.abs()));
             for (xi, d) in x.iter_mut().zip(&dx) {
                 *xi += d;
             }
             if !x.iter().all(|v| v.is_finite()) {
                 break;
             }
-            if dx.iter().all(|d| d.abs() <= 1e-13 * size) {
+            // With a stiff force the residual's round-off is that of the force (`k ℓ`), far
+            // above the accelerations': the corrections then stop shrinking at a floor. Once
+            // they do, and they move the positions (by `β h² dx`) by no more than round-off
+            // of the coordinates, the iteration is done.
+            let positions = self.u.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+            let stalled = correction > 0.5 * previous
+                && self.c.beta * h * h * correction <= 1e-14 * positions;
+            previous = correction;
+            if stalled || dx.iter().all(|d| d.abs() <= 1e-13 * size) {
                 let [a, u, rate] = self.update(&x, h);
                 (self.a, self.u, self.rate, self.accel) = (a, u, rate, x);
                 self.t += h;

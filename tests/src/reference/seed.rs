@@ -252,6 +252,27 @@ mod tests {
     }
 
     #[test]
+    fn the_examples_reduced_equation_is_this_one() {
+        // `mechgen_examples::free_seed` (RK4, for the example binary and the benchmarks)
+        // derives the same equation independently (dual numbers, not the written-out
+        // derivatives): the two must not drift apart.
+        let (ours, theirs) = (
+            FreeSeed::default(),
+            mechgen_examples::free_seed::FreeSeed::default(),
+        );
+        for (phi, rate) in [(0.3, 0.0), (1.0, -20.0), (2.5, 35.0), (-0.4, 5.0)] {
+            let (a, b) = (
+                ours.acceleration(phi, rate),
+                theirs.acceleration([phi, rate]),
+            );
+            assert!(
+                (a - b).abs() <= 1e-12 * a.abs().max(1.0),
+                "{phi}, {rate}: {a} vs {b}"
+            );
+        }
+    }
+
+    #[test]
     fn the_free_seed_conserves_its_energy_to_1e12() {
         let seed = FreeSeed::default();
         let times: Vec<f64> = (1..=100).map(|i| i as f64 * 0.005).collect();

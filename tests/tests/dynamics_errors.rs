@@ -113,8 +113,9 @@ fn a_step_below_the_minimum_is_a_typed_error() {
     let mut integrator = start(Weighted::default(), options);
     let before = integrator.state().q;
     match integrator.step() {
-        Err(DynamicsError::StepTooSmall { t, step }) => {
+        Err(DynamicsError::StepTooSmall { t, step, min }) => {
             assert_eq!(t, 0.0);
+            assert_eq!(min, 1e-2);
             assert!(step <= 1e-2, "{step}");
         }
         other => panic!(

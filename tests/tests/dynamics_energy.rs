@@ -147,10 +147,12 @@ fn a_damped_seed_loses_what_its_damper_dissipates() {
 
     // Bounds: generalized-α (ρ∞ = 0.9) on the reduced equation, emulated at this step with
     // the trapezoidal quadrature of the damper's power, balances to 1.1e-7 and dissipates
-    // within 2.2e-8 of the reference.
+    // within 2.2e-8 of the reference (measured here: 1.1e-7 and 9.6e-8, the latter including
+    // the Newton tolerance's share over 10,000 steps).
     let mut integrator = start(DampedSeed::default(), fixed(1e-4, 0.9));
     let total = integrator.energy().total();
     let mut previous = 0.0;
+    let mut largest = [0.0f64; 2];
     for (s, y) in sample(&mut integrator, &at).iter().zip(&exact) {
         let book = s.energy;
         assert!(
@@ -161,9 +163,10 @@ fn a_damped_seed_loses_what_its_damper_dissipates() {
         previous = book.dissipated;
         let balance = (book.total() - total).abs() / scale;
         let lost = (book.dissipated - y[2]).abs() / dissipated;
+        largest = [largest[0].max(balance), largest[1].max(lost)];
         assert!(balance <= 5e-7, "t = {}: balance off by {balance:e}", s.t);
         assert!(
-            lost <= 1e-6,
+            lost <= 3e-7,
             "t = {}: dissipated {} vs {}",
             s.t,
             book.dissipated,
@@ -179,7 +182,9 @@ fn a_damped_seed_loses_what_its_damper_dissipates() {
         );
     }
     eprintln!(
-        "damped seed, 1 s, h = 1e-4: dissipated {previous:.6e} vs reference {dissipated:.6e}"
+        "damped seed, 1 s, h = 1e-4: dissipated {previous:.6e} vs reference {dissipated:.6e}; \
+         balance within {:.1e}, dissipation within {:.1e} (relative)",
+        largest[0], largest[1]
     );
 }
 
@@ -187,17 +192,21 @@ fn a_damped_seed_loses_what_its_damper_dissipates() {
 fn a_driver_s_work_balances_the_book() {
     // Bound: the reduced equation of the arm on its moving pivot, emulated with generalized-α
     // (ρ∞ = 0.9) at this step and the trapezoidal quadrature of the driver's power, balances to
-    // 1.6e-7.
+    // 1.6e-7 (measured here: 1.5e-7).
     let mut integrator = start(SwingOnACrank::default(), fixed(1e-4, 0.9));
     let total = integrator.energy().total();
     // The arm's weight over the crank's and arm's lengths.
     let scale = 0.5 * 9810.0 * 140.0;
-    let mut work = 0.0f64;
+    let (mut work, mut largest) = (0.0f64, 0.0f64);
     for s in sample(&mut integrator, &times(1.0, 50)) {
         let balance = (s.energy.total() - total).abs() / scale;
+        largest = largest.max(balance);
         assert!(balance <= 5e-7, "t = {}: balance off by {balance:e}", s.t);
         work = work.max(s.energy.drivers_work.abs());
     }
+    eprintln!(
+        "swing on a crank, 1 s, h = 1e-4: balance within {largest:.1e}, driver's work {work:.3e}"
+    );
     // The driver does work on the swinging arm: the term is exercised.
     assert!(work > 1e-2 * scale, "{work}");
 }

@@ -154,10 +154,10 @@ fn large_swings_keep_the_elliptic_integral_period() {
                  {fine:.1e} (T/2000), extrapolated {extrapolated:.1e}; worst angle {worst:.1e} rad"
             );
             // Emulated generalized-α (ρ∞ = 0.9) on the reduced equation: ≤ 3.3e-6, ≤ 1.4e-9
-            // extrapolated, angles within 1.1e-4 rad.
+            // extrapolated, angles within 1.1e-4 rad (measured: the same figures, 1.2e-9 at 2.8 rad).
             assert!(coarse.abs() <= 1e-5, "{label}, {amplitude}: {coarse:e}");
             assert!(
-                extrapolated.abs() <= 1e-7,
+                extrapolated.abs() <= 5e-9,
                 "{label}, {amplitude}: {extrapolated:e}"
             );
             assert!(worst <= 3e-4, "{label}, {amplitude}: {worst:e}");

@@ -117,7 +117,8 @@ fn the_double_pendulum_follows_its_lagrange_equations() {
 #[test]
 fn fixed_steps_are_generalized_alpha_on_the_lagrange_equations() {
     // Both free angles in one Newton iteration: the steps are those of
-    // `reference::generalized_alpha` on the two reduced equations, to the solvers' tolerances.
+    // `reference::generalized_alpha` on the two reduced equations, to the integrator's Newton
+    // tolerance (1e-10 rad; measured 1.3e-11 rad over 300 steps at ρ∞ = 1 and 0.6).
     for rho_inf in [1.0, 0.6] {
         let mut reduced = GeneralizedAlpha::new(
             |_, u: &[f64; 2], v: &[f64; 2]| {
@@ -130,18 +131,23 @@ fn fixed_steps_are_generalized_alpha_on_the_lagrange_equations() {
             rho_inf,
         );
         let mut integrator = start(DoublePendulum::default(), fixed(1e-3, rho_inf));
+        let mut largest = 0.0f64;
         for n in 1..=300 {
             integrator.step().unwrap_or_else(|e| panic!("{e}"));
             reduced.step(1e-3).unwrap_or_else(|e| panic!("{e}"));
             let [u, _, _] = reduced.state();
             for (k, expected) in u.iter().enumerate() {
                 let got = integrator.free_state(k)[0];
+                largest = largest.max((got - expected).abs());
                 assert!(
-                    (got - expected).abs() <= 1e-7,
+                    (got - expected).abs() <= 1e-10,
                     "ρ∞ = {rho_inf}, step {n}, free {k}: {got} vs {expected}"
                 );
             }
         }
+        eprintln!(
+            "double pendulum, h = 1 ms, ρ∞ = {rho_inf}: {largest:.1e} rad from generalized-α"
+        );
     }
 }
 
