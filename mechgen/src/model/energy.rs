@@ -144,6 +144,7 @@ mod tests {
             qdd: vec![0.0; q.len()],
             t,
             params: vec![],
+            free: Vec::new(),
         }
     }
 
