@@ -27,8 +27,8 @@ struct Sample {
 }
 
 fn main() {
-    let options = Options::from_args("piston_crank_free", std::env::args().skip(1))
-        .unwrap_or_else(|e| {
+    let options =
+        Options::from_args("piston_crank_free", std::env::args().skip(1)).unwrap_or_else(|e| {
             eprintln!("error: {e}");
             std::process::exit(2)
         });

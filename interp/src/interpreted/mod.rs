@@ -8,8 +8,8 @@
 //! one solver implementation of `mechgen-runtime` with scenes read from `.mech` files, and it
 //! agrees with generated code to the bit.
 
-mod motion;
 mod free;
+mod motion;
 mod plan;
 mod textbook;
 
@@ -23,8 +23,8 @@ use mechgen::model::physics;
 use mechgen_runtime::nalgebra::Dyn;
 use mechgen_runtime::{Matrix, Names, Outputs, Unit};
 
-use motion::MotionTapes;
 use free::FreeDofs;
+use motion::MotionTapes;
 use plan::PlanTapes;
 use textbook::{Textbook, unit};
 

@@ -8,10 +8,7 @@
 //! least-squares exponent p of time ∝ Nᵖ through them, as `growth.rs` does for the kinematic
 //! step (the issue's target: p ≤ 1.2).
 //!
-//! PENDING: written against the `Integrator` API of issue 22 (`mechgen_runtime::{Integrator,
-//! IntegratorOptions, StepControl}`); the scenes need the `free` grammar, hence the `dynamics`
-//! feature. Register it in `Cargo.toml` once both exist (and drop `pending_` from the name):
-//! `[[bench]] name = "pending_dynamics" harness = false required-features = ["dynamics"]`.
+//! The scenes need the `free` grammar, hence the `dynamics` feature (`required-features`).
 //!
 //! `cargo bench -p mechgen-growth --features dynamics --bench dynamics`
 
