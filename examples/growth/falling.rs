@@ -2,7 +2,7 @@
 //! at α0 it folds under gravity (m, kg, rad, s). The linkage is `mechgen-scissor`'s
 //! (`scene.rs`); this adds the mass properties, gravity and the `free` declaration in place of
 //! the driver. Written by `build.rs` with the `dynamics` feature, for the growth benchmark of
-//! forward dynamics (`benches/pending_dynamics.rs`).
+//! forward dynamics (`benches/dynamics.rs`).
 
 use mechgen::builder::SceneBuilder;
 

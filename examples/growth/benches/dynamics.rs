@@ -4,14 +4,12 @@
 //! releases the lift from a new `Integrator` (assembly and initial accelerations, not timed)
 //! and times 40 fixed generalized-α steps of 1e-3 s (ρ∞ = 0.9, the default).
 //!
-//! After criterion's figures, the run prints each size's fastest batch per step and the
-//! least-squares exponent p of time ∝ Nᵖ through them, as `growth.rs` does for the kinematic
-//! step (the issue's target: p ≤ 1.2).
+//! After criterion's figures (per release of 40 steps), the run prints each size's median and
+//! fastest batch per step, the Newton iterations per step, and the least-squares exponent p of
+//! time ∝ Nᵖ through the medians and through the fastest, as `growth.rs` does for the
+//! kinematic step (the issue's target: p ≤ 1.2).
 //!
-//! PENDING: written against the `Integrator` API of issue 22 (`mechgen_runtime::{Integrator,
-//! IntegratorOptions, StepControl}`); the scenes need the `free` grammar, hence the `dynamics`
-//! feature. Register it in `Cargo.toml` once both exist (and drop `pending_` from the name):
-//! `[[bench]] name = "pending_dynamics" harness = false required-features = ["dynamics"]`.
+//! The scenes need the `free` grammar, hence the `dynamics` feature (`required-features`).
 //!
 //! `cargo bench -p mechgen-growth --features dynamics --bench dynamics`
 
@@ -45,13 +43,36 @@ where
     Integrator::new(Solver::new(lift.clone()), 0.0, options).expect("the lift assembles")
 }
 
-/// Times `lift` under `name`, keeping the fastest batch's time per step in `fastest`.
-fn time<M>(c: &mut Criterion, name: &str, lift: M, fastest: &RefCell<f64>)
+/// Every batch's time per step of one size (seconds), and its release's Newton iterations
+/// per step.
+#[derive(Default)]
+struct Size {
+    batches: RefCell<Vec<f64>>,
+    iterations: RefCell<f64>,
+}
+
+impl Size {
+    /// `(median, fastest)` over the batches, if any.
+    fn times(&self) -> Option<(f64, f64)> {
+        let mut sorted = self.batches.borrow().clone();
+        sorted.sort_by(f64::total_cmp);
+        let middle = sorted.len() / 2;
+        let median = match sorted.len() {
+            0 => return None,
+            n if n % 2 == 1 => sorted[middle],
+            _ => 0.5 * (sorted[middle - 1] + sorted[middle]),
+        };
+        Some((median, sorted[0]))
+    }
+}
+
+/// Times `lift` under `name`, keeping every batch's time per step in `size`.
+fn time<M>(c: &mut Criterion, name: &str, lift: M, size: &Size)
 where
     M: Dynamic + EquationsOfMotion + Structured + Clone,
     DefaultAllocator: Storage<M::Dim> + FreeStorage<M::Dim, M::Free>,
 {
-    let mut group = c.benchmark_group("falling_scissor/step");
+    let mut group = c.benchmark_group("falling_scissor/release_of_40_steps");
     group.sample_size(10);
     group.bench_function(name, |b| {
         b.iter_custom(|iterations| {
@@ -66,12 +87,16 @@ where
                 elapsed += start.elapsed();
             }
             let per_step = elapsed.as_secs_f64() / (iterations as f64 * f64::from(STEPS));
-            let mut best = fastest.borrow_mut();
-            *best = best.min(per_step);
+            size.batches.borrow_mut().push(per_step);
             elapsed
         });
     });
     group.finish();
+    let mut integrator = release(&lift);
+    for _ in 0..STEPS {
+        integrator.step().expect("the lift falls");
+    }
+    *size.iterations.borrow_mut() = integrator.stats().iterations as f64 / f64::from(STEPS);
 }
 
 fn main() {
@@ -79,8 +104,7 @@ fn main() {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(3))
         .configure_from_args();
-    let sizes: [(usize, RefCell<f64>); 3] =
-        [10, 100, 1000].map(|n| (n, RefCell::new(f64::INFINITY)));
+    let sizes: [(usize, Size); 3] = [10, 100, 1000].map(|n| (n, Size::default()));
     time(
         &mut c,
         "10",
@@ -101,17 +125,33 @@ fn main() {
     );
     c.final_summary();
 
-    // Fastest batch per step, and the least-squares slope of log(time) over log(N).
-    let points: Vec<(f64, f64)> = sizes
+    // Median and fastest batch per step, and the least-squares slope of log(time) over log(N)
+    // through each.
+    let points: Vec<(f64, (f64, f64), f64)> = sizes
         .iter()
-        .filter(|(_, t)| t.borrow().is_finite())
-        .map(|(n, t)| ((6 * n + 12) as f64, *t.borrow()))
+        .filter_map(|(n, size)| {
+            let coordinates = (6 * n + 12) as f64;
+            Some((coordinates, size.times()?, *size.iterations.borrow()))
+        })
         .collect();
-    println!("\nfalling scissor lift, fastest batch per fixed step of {H} s:");
-    for (coordinates, seconds) in &points {
-        println!("  N = {coordinates:>5}: {:>10.2} µs", seconds * 1e6);
+    println!("\nfalling scissor lift, per fixed step of {H} s (median batch, fastest):");
+    for (coordinates, (median, fastest), iterations) in &points {
+        println!(
+            "  N = {coordinates:>5}: {:>10.2} µs ({:>10.2}), {iterations:.2} Newton iterations \
+             per step",
+            median * 1e6,
+            fastest * 1e6
+        );
     }
     if points.len() >= 2 {
-        println!("  fitted exponent: time ∝ N^{:.3}", fit::exponent(&points));
+        let fit = |pick: fn(&(f64, f64)) -> f64| {
+            let xy: Vec<(f64, f64)> = points.iter().map(|(n, t, _)| (*n, pick(t))).collect();
+            fit::exponent(&xy)
+        };
+        println!(
+            "  fitted exponent: time ∝ N^{:.3} (medians), N^{:.3} (fastest)",
+            fit(|t| t.0),
+            fit(|t| t.1)
+        );
     }
 }

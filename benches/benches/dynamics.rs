@@ -2,27 +2,24 @@
 //! mass properties, the crank released from rest at 0.3 rad under gravity), in one run beside
 //! the driven seed's kinematic step and beside the peer, Exudyn.
 //!
-//! PENDING: written against the `Integrator` API of issue 22 (`mechgen_runtime::{Integrator,
-//! IntegratorOptions, StepControl}`) and the free seed's `mechanism!` twin
-//! (`mechgen_examples::scenes::PistonCrankFree`); register it in `Cargo.toml` once both exist:
-//! `[[bench]] name = "pending_dynamics" harness = false` (and drop `pending_` from the name).
-//!
 //! Groups:
 //! - `free_seed/fixed/{generated,interpreted}`: one accepted generalized-α step of 1e-4 s
 //!   (ρ∞ = 0.9, the default), the release restarted from a new `Integrator` (assembled at
-//!   t = 0, not timed) every 5,000 steps, so every batch steps through the same 0.5 s motion.
+//!   t = 0, not timed) every 5,000 steps, every batch whole releases (the same 0.5 s motion).
 //! - `seed/generated`: the driven seed's `Simulation` step, as `kinematics.rs` times it (360
 //!   steps per revolution, the report's reference solver options), for the ratio.
 //! - `free_seed/adaptive`: the whole 0.5 s release in the error-controlled mode at rtol 1e-6
 //!   (atol 1e-9, the defaults), from a new `Integrator` (not timed).
 //!
-//! After criterion's figures the run prints the fastest batch per step of each, the ratio of
-//! the free step to the driven one, the adaptive run's steps (accepted, rejected), Newton
+//! After criterion's figures the run prints the median and the fastest batch per step of each
+//! (every batch steps through whole runs: see `time_steps`), the ratio of the medians of the
+//! free step and the driven one, the adaptive run's steps (accepted, rejected), Newton
 //! iterations and factorizations, the largest error of the crank angle at t = 0.1, …, 0.5 s
 //! against the reduced Lagrange reference ([`mechgen_examples::free_seed`], RK4 at 1e-5 s) for
 //! both modes, and, when `python3` with `exudyn` is installed, the peer's step on the same
-//! scene measured in this run (`benches/peer/exudyn_free_seed.py --summary`) with the ratio.
-//! Fastest batches, because the machines are shared and noise only ever adds time.
+//! scene measured in this run (`benches/peer/exudyn_free_seed.py --summary`) with the ratio
+//! of the medians and both errors (without them, a note says why). The fastest batches beside
+//! the medians, because the machines are shared and noise only ever adds time.
 //!
 //! `cargo bench -p mechgen-benches --bench dynamics`
 
@@ -53,29 +50,45 @@ const START: f64 = 0.3;
 /// Output times per revolution of the driven seed, as in `kinematics.rs`.
 const DRIVEN_STEPS: u64 = 360;
 
-/// The fastest batch per step of each timed method.
+/// Every batch's time per step of each timed method (seconds).
 #[derive(Default)]
-struct Fastest(RefCell<Vec<(String, f64)>>);
+struct Timings(RefCell<Vec<(String, Vec<f64>)>>);
 
-impl Fastest {
+impl Timings {
     fn record(&self, name: &str, seconds: f64) {
         let mut all = self.0.borrow_mut();
         match all.iter_mut().find(|(n, _)| n == name) {
-            Some((_, best)) => *best = best.min(seconds),
-            None => all.push((name.to_owned(), seconds)),
+            Some((_, batches)) => batches.push(seconds),
+            None => all.push((name.to_owned(), vec![seconds])),
         }
     }
 
-    fn get(&self, name: &str) -> Option<f64> {
-        self.0.borrow().iter().find(|(n, _)| n == name).map(|p| p.1)
+    /// `(median, fastest)` over the batches of `name`.
+    fn get(&self, name: &str) -> Option<(f64, f64)> {
+        let all = self.0.borrow();
+        let (_, batches) = all.iter().find(|(n, _)| n == name)?;
+        let mut sorted = batches.clone();
+        sorted.sort_by(f64::total_cmp);
+        let middle = sorted.len() / 2;
+        let median = if sorted.len() % 2 == 1 {
+            sorted[middle]
+        } else {
+            0.5 * (sorted[middle - 1] + sorted[middle])
+        };
+        Some((median, sorted[0]))
     }
 }
 
 /// Times `step` as criterion's `step` in `group`: `step(run, k)` takes step k (1-based) of a
 /// run that `start()` begins afresh (not timed) every `chunk` steps.
+///
+/// Every batch steps through whole runs (criterion's iteration count rounded up to a multiple
+/// of `chunk`, the time scaled back to the count): the cost of a step changes along a motion
+/// (the free seed's early steps, near rest, converge in fewer iterations), and a batch of the
+/// first steps alone would be faster than the motion's average.
 fn time_steps<S>(
     group: &mut BenchmarkGroup<'_, WallTime>,
-    fastest: &Fastest,
+    timings: &Timings,
     name: &str,
     chunk: u64,
     start: impl Fn() -> S,
@@ -83,20 +96,19 @@ fn time_steps<S>(
 ) {
     group.bench_function("step", |b| {
         b.iter_custom(|iterations| {
+            let runs = iterations.div_ceil(chunk).max(1);
             let mut total = Duration::ZERO;
-            let mut done = 0;
-            while done < iterations {
-                let steps = (iterations - done).min(chunk);
+            for _ in 0..runs {
                 let mut run = start();
                 let started = Instant::now();
-                for k in 1..=steps {
+                for k in 1..=chunk {
                     step(&mut run, k);
                 }
                 total += started.elapsed();
-                done += steps;
             }
-            fastest.record(name, total.as_secs_f64() / iterations as f64);
-            total
+            let per_step = total.as_secs_f64() / (runs * chunk) as f64;
+            timings.record(name, per_step);
+            Duration::from_secs_f64(per_step * iterations as f64)
         });
     });
 }
@@ -132,7 +144,7 @@ fn adaptive() -> StepControl {
 }
 
 /// One fixed step of the free seed, `mechanism` generated or interpreted.
-fn free_fixed<M>(c: &mut Criterion, fastest: &Fastest, label: &str, mechanism: M)
+fn free_fixed<M>(c: &mut Criterion, timings: &Timings, label: &str, mechanism: M)
 where
     M: Dynamic + EquationsOfMotion + Structured + Clone,
     DefaultAllocator: Storage<M::Dim> + FreeStorage<M::Dim, M::Free>,
@@ -141,7 +153,7 @@ where
     let chunk = (RELEASE / STEP).round() as u64;
     time_steps(
         &mut group,
-        fastest,
+        timings,
         label,
         chunk,
         || release(mechanism.clone(), fixed()),
@@ -154,7 +166,7 @@ where
 }
 
 /// The driven seed's kinematic step, as `kinematics.rs` times it.
-fn driven(c: &mut Criterion, fastest: &Fastest) {
+fn driven(c: &mut Criterion, timings: &Timings) {
     let seed = PistonCrank::default();
     let h = 2.0 * std::f64::consts::PI / seed.omega / DRIVEN_STEPS as f64;
     let options = Plan::full().reference.options();
@@ -163,7 +175,7 @@ fn driven(c: &mut Criterion, fastest: &Fastest) {
     let mut group = c.benchmark_group("seed/generated");
     time_steps(
         &mut group,
-        fastest,
+        timings,
         "seed/generated",
         DRIVEN_STEPS,
         || checkpoint.clone(),
@@ -176,7 +188,7 @@ fn driven(c: &mut Criterion, fastest: &Fastest) {
 }
 
 /// The whole release in the error-controlled mode.
-fn free_adaptive(c: &mut Criterion, fastest: &Fastest) {
+fn free_adaptive(c: &mut Criterion, timings: &Timings) {
     let mut group = c.benchmark_group("free_seed/adaptive");
     group.bench_function("release", |b| {
         b.iter_custom(|iterations| {
@@ -188,7 +200,7 @@ fn free_adaptive(c: &mut Criterion, fastest: &Fastest) {
                 total += started.elapsed();
                 black_box(integrator.free_state(0)[0]);
             }
-            fastest.record(
+            timings.record(
                 "free_seed/adaptive",
                 total.as_secs_f64() / iterations as f64,
             );
@@ -214,9 +226,16 @@ fn accuracy(control: StepControl, reference: &[[f64; 2]]) -> (f64, String) {
     (worst, counts)
 }
 
-/// The peer's figures measured now: `(µs per step, max |Δφ|)` from the script's `--summary`
-/// line, or why there are none.
-fn exudyn() -> Result<(f64, f64), String> {
+/// The peer's figures measured now, from the script's `--summary` line, or why there are none.
+struct Peer {
+    /// Seconds per step: median and fastest of the script's runs.
+    median: f64,
+    fastest: f64,
+    /// Largest |φ − φ_ref| at [`TIMES`] (rad).
+    error: f64,
+}
+
+fn exudyn() -> Result<Peer, String> {
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/peer/exudyn_free_seed.py");
     let output = Command::new("python3")
         .args([script, "--summary", "--step", &STEP.to_string()])
@@ -233,51 +252,76 @@ fn exudyn() -> Result<(f64, f64), String> {
             .and_then(|value| value.parse::<f64>().ok())
             .ok_or_else(|| format!("no `{key}` in {text:?}"))
     };
-    Ok((field("us_per_step_fastest")? * 1e-6, field("max_abs_dphi")?))
+    Ok(Peer {
+        median: field("us_per_step_median")? * 1e-6,
+        fastest: field("us_per_step_fastest")? * 1e-6,
+        error: field("max_abs_dphi")?,
+    })
 }
 
-fn summary(fastest: &Fastest) {
+/// `median ns (fastest ns)` of a time per step.
+fn nanoseconds((median, fastest): (f64, f64)) -> String {
+    format!("{:>8.1} ns (fastest {:>8.1})", median * 1e9, fastest * 1e9)
+}
+
+fn summary(timings: &Timings) {
     let reference = FreeSeed::default().release([START, 0.0], &TIMES, 1e-5);
     let (fixed_error, fixed_counts) = accuracy(fixed(), &reference);
     let (adaptive_error, adaptive_counts) = accuracy(adaptive(), &reference);
     println!(
-        "\nfree seed (fastest batch per step; max |Δφ| at t = 0.1 … 0.5 s against the \
-         reference):"
+        "\nfree seed: median batch per step (fastest), max |Δφ| at t = 0.1 … 0.5 s against the \
+         reduced Lagrange reference"
     );
-    let driven = fastest.get("seed/generated");
+    let driven = timings.get("seed/generated");
+    let generated = timings.get("free_seed/fixed/generated");
     for (label, what) in [
         ("free_seed/fixed/generated", "generated"),
         ("free_seed/fixed/interpreted", "interpreted"),
     ] {
-        if let Some(step) = fastest.get(label) {
-            let ratio = driven.map_or(String::from("—"), |d| format!("{:.2}", step / d));
+        if let Some(step) = timings.get(label) {
+            let ratio = driven.map_or(String::from("—"), |d| format!("{:.2}", step.0 / d.0));
             println!(
-                "  fixed step {STEP:e} s, {what:<11} {:>10.1} ns  ({ratio}× the driven seed's \
-                 kinematic step)",
-                step * 1e9
+                "  fixed step {STEP:e} s, {what:<11} {}  = {ratio}× the driven step",
+                nanoseconds(step)
             );
         }
     }
     if let Some(d) = driven {
-        println!("  driven seed, Simulation step:   {:>10.1} ns", d * 1e9);
+        println!("  driven seed, kinematic step     {}", nanoseconds(d));
     }
     println!("  fixed step: max |Δφ| = {fixed_error:.3e} rad; {fixed_counts}");
-    if let Some(release) = fastest.get("free_seed/adaptive") {
+    if let Some((median, fastest)) = timings.get("free_seed/adaptive") {
         println!(
-            "  adaptive (rtol 1e-6, atol 1e-9): the 0.5 s release in {:.1} µs, max |Δφ| = \
-             {adaptive_error:.3e} rad; {adaptive_counts}",
-            release * 1e6
+            "  adaptive (rtol 1e-6, atol 1e-9): the {RELEASE} s release in {:.1} µs (fastest \
+             {:.1}), max |Δφ| = {adaptive_error:.3e} rad; {adaptive_counts}",
+            median * 1e6,
+            fastest * 1e6
         );
     }
-    match (exudyn(), fastest.get("free_seed/fixed/generated")) {
-        (Ok((peer, peer_error)), Some(ours)) => println!(
-            "  Exudyn, same scene and step, this run: {:.2} µs per step, max |Δφ| = \
-             {peer_error:.3e} rad: {:.0}× the generated step",
-            peer * 1e6,
-            peer / ours
-        ),
-        (Err(why), _) => println!("  Exudyn not measured: {why}"),
-        (Ok(_), None) => {}
+    match exudyn() {
+        Ok(peer) => {
+            println!(
+                "  Exudyn, same scene and step, this run: {:.2} µs per step (fastest {:.2}), \
+                 max |Δφ| = {:.3e} rad",
+                peer.median * 1e6,
+                peer.fastest * 1e6,
+                peer.error
+            );
+            if let Some((ours, _)) = generated {
+                let accuracy = if fixed_error <= peer.error {
+                    "ours as accurate or more"
+                } else {
+                    "ours LESS accurate"
+                };
+                println!(
+                    "  Exudyn / generated fixed step: {:.1}× (medians; {accuracy}: {fixed_error:.3e} \
+                     against {:.3e} rad)",
+                    peer.median / ours,
+                    peer.error
+                );
+            }
+        }
+        Err(why) => println!("  Exudyn not measured: {why}"),
     }
 }
 
@@ -286,7 +330,7 @@ fn main() {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(2))
         .configure_from_args();
-    let fastest = Fastest::default();
+    let timings = Timings::default();
     let path = concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../examples/scenes/piston_crank_free.mech"
@@ -296,18 +340,18 @@ fn main() {
         .unwrap_or_else(|e| panic!("{path}: {e}"));
     free_fixed(
         &mut c,
-        &fastest,
+        &timings,
         "free_seed/fixed/generated",
         PistonCrankFree::default(),
     );
     free_fixed(
         &mut c,
-        &fastest,
+        &timings,
         "free_seed/fixed/interpreted",
         Interpreted::new(&scene),
     );
-    driven(&mut c, &fastest);
-    free_adaptive(&mut c, &fastest);
+    driven(&mut c, &timings);
+    free_adaptive(&mut c, &timings);
     c.final_summary();
-    summary(&fastest);
+    summary(&timings);
 }
