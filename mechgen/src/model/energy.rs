@@ -68,41 +68,52 @@ pub fn derive(model: &mut Model) -> Energy {
         energy.gravity = arena.sub(energy.gravity, work);
     }
     for load in loads {
-        match load {
-            LoadKind::Force {
-                point,
-                value,
-                local,
-            } => {
-                let (force, at) = world_force(&mut frames, point, value, local);
-                let velocity = at.map(|x| diff.time_derivative(frames.arena, x));
-                let power = frames.dot(force, velocity);
-                energy.loads = frames.arena.add(energy.loads, power);
-            }
-            LoadKind::Torque { body, value } => {
-                let angle = frames.pose(body, 2);
-                let rate = diff.time_derivative(frames.arena, angle);
-                let arena = &mut *frames.arena;
-                let power = arena.mul(value, rate);
-                energy.loads = arena.add(energy.loads, power);
-            }
-            LoadKind::Spring {
-                a,
-                b,
-                stiffness,
-                length,
-                damping,
-            } => {
-                let line = spring_geometry(&mut frames, &mut diff, a, b);
-                let arena = &mut *frames.arena;
-                let stored = spring_energy(arena, &line, stiffness, length);
-                energy.springs = arena.add(energy.springs, stored);
-                let dissipated = damper_power(arena, &line, damping);
-                energy.dampers = arena.add(energy.dampers, dissipated);
-            }
-        }
+        add_load(&mut energy, &mut frames, &mut diff, load);
     }
     energy
+}
+
+/// Adds `load`'s power (a force or torque) or its stored energy and dissipation (a
+/// spring-damper) to `energy`.
+fn add_load(
+    energy: &mut Energy,
+    frames: &mut Frames<'_>,
+    diff: &mut Differentiator,
+    load: LoadKind,
+) {
+    match load {
+        LoadKind::Force {
+            point,
+            value,
+            local,
+        } => {
+            let (force, at) = world_force(frames, point, value, local);
+            let velocity = at.map(|x| diff.time_derivative(frames.arena, x));
+            let power = frames.dot(force, velocity);
+            energy.loads = frames.arena.add(energy.loads, power);
+        }
+        LoadKind::Torque { body, value } => {
+            let angle = frames.pose(body, 2);
+            let rate = diff.time_derivative(frames.arena, angle);
+            let arena = &mut *frames.arena;
+            let power = arena.mul(value, rate);
+            energy.loads = arena.add(energy.loads, power);
+        }
+        LoadKind::Spring {
+            a,
+            b,
+            stiffness,
+            length,
+            damping,
+        } => {
+            let line = spring_geometry(frames, diff, a, b);
+            let arena = &mut *frames.arena;
+            let stored = spring_energy(arena, &line, stiffness, length);
+            energy.springs = arena.add(energy.springs, stored);
+            let dissipated = damper_power(arena, &line, damping);
+            energy.dampers = arena.add(energy.dampers, dissipated);
+        }
+    }
 }
 
 /// `½ k (ℓ − L)²`, `ℓ = √(d · d)`.
