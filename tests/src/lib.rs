@@ -3,6 +3,7 @@
 //! CI test and the `cargo fuzz` targets share, and the reference solutions of the
 //! forward-dynamics tests (`reference`).
 
+pub mod counting;
 pub mod fuzzing;
 pub mod reference;
 

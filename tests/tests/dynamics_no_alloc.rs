@@ -8,64 +8,12 @@
 //! A counting global allocator wraps the system one (as `no_alloc.rs`); this file holds a
 //! single test so that no other test thread allocates while it counts.
 
-use core::alloc::{GlobalAlloc, Layout};
-use core::cell::Cell;
-use core::fmt::{self, Write};
-use core::sync::atomic::{AtomicUsize, Ordering};
-use std::alloc::System;
-
+use core::fmt::Write;
 use mechgen_runtime::{Integrator, IntegratorOptions, Solver, StepControl};
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-thread_local! {
-    // Only the measuring thread counts (see `no_alloc.rs`).
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-}
-
-fn count() {
-    if COUNTING.with(Cell::get) {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-    }
-}
-
-struct Counting;
-
-// Implementing `GlobalAlloc` requires `unsafe`; this impl only counts and forwards to `System`.
-#[allow(unsafe_code)]
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc_zeroed(layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count();
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
+use mechgen_tests::counting::{self, Counting, Sink};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
-
-/// A `fmt::Write` that only counts bytes, standing in for a UART or a fixed buffer.
-struct Sink(usize);
-
-impl Write for Sink {
-    fn write_str(&mut self, s: &str) -> fmt::Result {
-        self.0 += s.len();
-        Ok(())
-    }
-}
 
 mechgen_runtime::mechanism! {
     mechanism SprungFreeSeed {
@@ -92,13 +40,13 @@ mechgen_runtime::mechanism! {
 
 #[test]
 fn the_forward_dynamics_allocate_nothing() {
-    COUNTING.with(|c| c.set(true));
+    counting::start();
     // The counter is live: a real allocation is seen.
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = counting::allocations();
     drop(core::hint::black_box(Box::new(0_u8)));
-    assert!(ALLOCATIONS.load(Ordering::SeqCst) > before);
+    assert!(counting::allocations() > before);
 
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = counting::allocations();
     let mut sink = Sink(0);
     let fixed = IntegratorOptions {
         rho_inf: 0.5,
@@ -165,8 +113,8 @@ fn the_forward_dynamics_allocate_nothing() {
     }
     assert!(integrator.set_free(0, f64::NAN, 0.0).is_err());
 
-    let allocations = ALLOCATIONS.load(Ordering::SeqCst) - before;
-    COUNTING.with(|c| c.set(false));
+    let allocations = counting::allocations() - before;
+    counting::stop();
     assert!(sink.0 > 0);
     assert_eq!(
         allocations, 0,

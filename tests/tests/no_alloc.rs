@@ -7,12 +7,7 @@
 //! A counting global allocator wraps the system one. This file holds a single test so that no
 //! other test thread allocates while it counts.
 
-use core::alloc::{GlobalAlloc, Layout};
-use core::cell::Cell;
-use core::fmt::{self, Write};
-use core::sync::atomic::{AtomicUsize, Ordering};
-use std::alloc::System;
-
+use core::fmt::Write;
 use mechgen_examples::scenes::{
     FourBar, PistonCrank, PistonCrankBodies, PistonCrankDynamics, PistonCrankDynamicsForces,
 };
@@ -20,69 +15,20 @@ use mechgen_examples::stability::{
     self, FlexiblePistonCrank, Parallelogram, SliderCrank, Unclosable,
 };
 use mechgen_runtime::{Dense, Mechanism, Simulation, SolveError, Solver, write_csv_header};
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-thread_local! {
-    // Only the measuring thread counts: libtest's own threads may allocate meanwhile (output
-    // capture, timing), which made a global count flaky under load. A `const` `Cell` needs no
-    // allocation or destructor, so reading it inside the allocator is safe.
-    static COUNTING: Cell<bool> = const { Cell::new(false) };
-}
-
-fn count() {
-    if COUNTING.with(Cell::get) {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
-    }
-}
-
-struct Counting;
-
-// Implementing `GlobalAlloc` requires `unsafe`; this impl only counts and forwards to `System`.
-#[allow(unsafe_code)]
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc(layout) }
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        count();
-        unsafe { System.alloc_zeroed(layout) }
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        count();
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-}
+use mechgen_tests::counting::{self, Counting, Sink};
 
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
-/// A `fmt::Write` that only counts bytes, standing in for a UART or a fixed buffer.
-struct Sink(usize);
-
-impl Write for Sink {
-    fn write_str(&mut self, s: &str) -> fmt::Result {
-        self.0 += s.len();
-        Ok(())
-    }
-}
-
 #[test]
 fn generated_scenes_solve_without_allocating() {
-    COUNTING.with(|c| c.set(true));
+    counting::start();
     // The counter is live: a real allocation is seen.
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = counting::allocations();
     drop(core::hint::black_box(Box::new(0_u8)));
-    assert!(ALLOCATIONS.load(Ordering::SeqCst) > before);
+    assert!(counting::allocations() > before);
 
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = counting::allocations();
     let mut sink = Sink(0);
     let mut simulation = Simulation::new(Solver::new(PistonCrank::default()), 0.0).expect("seed");
     let mut piston_travel = 0.0f64;
@@ -191,7 +137,7 @@ fn generated_scenes_solve_without_allocating() {
     )
     .unwrap();
     assert_eq!(steps, 501);
-    let allocations = ALLOCATIONS.load(Ordering::SeqCst) - before;
+    let allocations = counting::allocations() - before;
 
     assert_eq!(allocations, 0, "heap allocations in solve paths");
     assert!(sink.0 > 0 && piston_travel > 180.0);
