@@ -80,6 +80,13 @@ fn options_out_of_range_are_refused() {
         ("negative rtol", adaptive(-1e-6, 1e-9, 1e-12, 1.0)),
         ("min above max", adaptive(1e-6, 1e-9, 1.0, 1e-3)),
         (
+            "no step budget",
+            IntegratorOptions {
+                max_steps: 0,
+                ..IntegratorOptions::default()
+            },
+        ),
+        (
             "no Newton iterations",
             IntegratorOptions {
                 max_iterations: 0,
@@ -126,6 +133,58 @@ fn a_step_below_the_minimum_is_a_typed_error() {
     // The last accepted state is kept.
     assert_eq!(integrator.t(), 0.0);
     assert_eq!(integrator.state().q, before);
+}
+
+/// Far from t = 0 a step below the clock's spacing would leave the time standing (a hang in
+/// `step_to`) or move it by another step than the motion's: a typed error instead.
+#[test]
+fn a_step_the_clock_cannot_resolve_is_a_typed_error() {
+    let t0 = 1e9;
+    // The spacing of times near 1e9 is 1.2e-7: a step of 1e-8 rounds to 0.
+    let mut integrator = Integrator::new(Solver::new(Weighted::default()), t0, fixed(1e-8, 0.9))
+        .unwrap_or_else(|e| panic!("{e}"));
+    for result in [
+        integrator.step().map(|s| s.t),
+        integrator.step_to(t0 + 1e-6).map(|s| s.t),
+    ] {
+        match result {
+            Err(DynamicsError::StepBelowClock { t, step }) => {
+                assert_eq!((t, step), (t0, 1e-8));
+            }
+            other => panic!("expected a step below the clock, got {other:?}"),
+        }
+    }
+    assert_eq!(integrator.t(), t0);
+    // A step the clock resolves runs from there (each step the one the clock takes, within
+    // a hundredth of 1e-3).
+    let mut integrator = Integrator::new(Solver::new(Weighted::default()), t0, fixed(1e-3, 0.9))
+        .unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(integrator.step_to(t0 + 0.01).map(|s| s.t), Ok(t0 + 0.01));
+}
+
+/// A call that needs more steps than `max_steps` stops with a typed error at the last
+/// accepted state, whatever asked for them (a long span, a tight tolerance).
+#[test]
+fn a_run_past_its_step_budget_is_a_typed_error() {
+    let options = IntegratorOptions {
+        max_steps: 10,
+        ..fixed(1e-3, 0.9)
+    };
+    let mut integrator = start(Weighted::default(), options);
+    match integrator.step_to(1.0).map(|s| s.t) {
+        Err(DynamicsError::StepBudget { t, steps }) => {
+            assert_eq!(steps, 10);
+            assert!((t - 0.01).abs() < 1e-12, "{t}");
+        }
+        other => panic!("expected the step budget, got {other:?}"),
+    }
+    assert!((integrator.t() - 0.01).abs() < 1e-12);
+    let mut calls = 0;
+    let result = integrator.run(1.0, |_, _| calls += 1);
+    assert!(matches!(result, Err(DynamicsError::StepBudget { .. })));
+    assert_eq!(calls, 10);
+    // Each call has its own budget: a nearer time is reached.
+    assert!(integrator.step_to(integrator.t() + 0.005).is_ok());
 }
 
 #[test]

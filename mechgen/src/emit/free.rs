@@ -55,7 +55,9 @@ impl Context<'_> {
         let name = &model.name;
         let count = idx(model.frees.len());
         let names = model.frees.iter().map(|f| f.name.to_string());
-        let equations = (0..model.frees.len()).map(|k| idx(model.free_equation(k).unwrap_or(0)));
+        // Every free degree of freedom has its equation; were one missing, the array would be
+        // short and the generated code would not compile (never a wrong row).
+        let equations = (0..model.frees.len()).filter_map(|k| model.free_equation(k).map(idx));
         let initial = model.frees.iter().enumerate().map(|(k, f)| {
             let k = idx(k);
             let from = match f.from {

@@ -16,6 +16,9 @@ use crate::structure::Structured;
 
 /// A step within this fraction of the time left lands on it (rather than leave a sliver).
 const LANDING_SLACK: f64 = 1e-9;
+/// The largest relative difference between a planned step and the step the clock takes (the
+/// step the motion then takes too, so that the two never part).
+const CLOCK_RESOLUTION: f64 = 0.01;
 /// A failed iteration retries with the step times this (error-controlled mode).
 const RETRY_SHRINK: f64 = 0.25;
 
@@ -28,7 +31,7 @@ where
     /// an error estimate above the tolerance or a failed iteration, down to the minimum step.
     pub(super) fn advance(&mut self, limit: Option<f64>) -> Result<(), DynamicsError> {
         loop {
-            let (h, t, clipped) = self.plan(limit);
+            let (h, t, clipped) = self.plan(limit)?;
             let outcome = self.solve_step(h, t).and_then(|()| self.check_iterate());
             let adaptive = match self.options.control {
                 StepControl::Fixed { .. } => None,
@@ -68,20 +71,29 @@ where
 
     /// The next attempt's step `h`, its end `t`, and whether it was shortened to land on
     /// `limit` (a step that would leave less than itself before `limit` is halved, so that
-    /// the last two steps are even).
-    fn plan(&self, limit: Option<f64>) -> (f64, f64, bool) {
+    /// the last two steps are even). The step is the one the clock takes, `t − t0`;
+    /// [`DynamicsError::StepBelowClock`] when that is not the step planned (to a hundredth).
+    fn plan(&self, limit: Option<f64>) -> Result<(f64, f64, bool), DynamicsError> {
         let t0 = self.state.t;
         let (h, adaptive) = match self.options.control {
             StepControl::Fixed { step } => (step, false),
             StepControl::Adaptive { max, .. } => (self.step.min(max), true),
         };
-        match limit {
+        let (h, t, clipped) = match limit {
             Some(end) if end - t0 <= h * (1.0 + LANDING_SLACK) => (end - t0, end, true),
             Some(end) if adaptive && end - t0 < 2.0 * h => {
                 let half = 0.5 * (end - t0);
                 (half, t0 + half, true)
             }
             _ => (h, t0 + h, false),
+        };
+        // Far from t = 0, `t0 + h` rounds: the motion takes the step the clock takes, and a
+        // step the clock cannot resolve (it would stand still: a hang) is refused.
+        let taken = t - t0;
+        if taken > 0.0 && (taken - h).abs() <= CLOCK_RESOLUTION * h {
+            Ok((taken, t, clipped))
+        } else {
+            Err(DynamicsError::StepBelowClock { t: t0, step: h })
         }
     }
 

@@ -85,6 +85,23 @@ pub enum DynamicsError {
         /// The free degree of freedom, when one is to blame.
         free: Option<usize>,
     },
+    /// The step is below what the clock resolves at `t`: `t + step` rounds to a time more than
+    /// a hundredth of the step away from it (far from t = 0 the floating-point spacing of
+    /// times grows; at worst the clock would stand still).
+    StepBelowClock {
+        /// Time the step starts from.
+        t: f64,
+        /// The step size that was refused.
+        step: f64,
+    },
+    /// One call ([`crate::Integrator::step_to`], [`crate::Integrator::run`]) took
+    /// [`crate::IntegratorOptions::max_steps`] steps without reaching its time.
+    StepBudget {
+        /// Time reached.
+        t: f64,
+        /// The steps taken in the call.
+        steps: u64,
+    },
     /// An option, a free state or a target time that is not usable (non-finite, out of range,
     /// a time behind the integrator's): `option` names it.
     BadOptions {
@@ -104,7 +121,9 @@ impl DynamicsError {
             | Self::Toggle { t, .. }
             | Self::NoConvergence { t, .. }
             | Self::SingularMass { t, .. }
-            | Self::NonFinite { t, .. } => Some(t),
+            | Self::NonFinite { t, .. }
+            | Self::StepBelowClock { t, .. }
+            | Self::StepBudget { t, .. } => Some(t),
             Self::BadOptions { .. } => None,
         }
     }
@@ -177,6 +196,17 @@ impl DynamicsError {
                     None => f.write_str("value"),
                 }
             }
+            Self::StepBelowClock { t, step } => write!(
+                f,
+                "at t = {t} a step of {step:e} is below what the time's floating-point spacing \
+                 resolves (t + h would round by more than a hundredth of h): take larger steps, \
+                 or start the run nearer t = 0"
+            ),
+            Self::StepBudget { t, steps } => write!(
+                f,
+                "{steps} steps reached t = {t} only, short of the time asked for: raise \
+                 max_steps, loosen rtol/atol, or ask for a nearer time"
+            ),
             Self::BadOptions { option, value } => {
                 write!(f, "integrator option `{option}` cannot be {value}")?;
                 f.write_str(match option {

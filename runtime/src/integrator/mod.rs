@@ -373,7 +373,9 @@ where
     /// otherwise as [`Integrator::step`] (the state is that of the last accepted step).
     pub fn step_to(&mut self, t: f64) -> Result<&State<M>, DynamicsError> {
         self.check_target(t)?;
+        let mut steps = 0;
         while self.state.t < t {
+            self.budget(&mut steps)?;
             self.advance(Some(t))?;
         }
         Ok(&self.state)
@@ -390,7 +392,9 @@ where
         mut each: impl FnMut(&State<M>, &Energy),
     ) -> Result<(), DynamicsError> {
         self.check_target(t_end)?;
+        let mut steps = 0;
         while self.state.t < t_end {
+            self.budget(&mut steps)?;
             self.advance(Some(t_end))?;
             each(&self.state, &self.book.energy);
         }
@@ -400,6 +404,18 @@ where
     /// Displays `error` with the scene's names ([`DynamicsError::describe`]).
     pub fn describe<'a>(&'a self, error: &'a DynamicsError) -> DescribedDynamics<'a, M> {
         error.describe(self.solver.mechanism())
+    }
+
+    /// Counts a step of one call against [`IntegratorOptions::max_steps`].
+    fn budget(&self, steps: &mut u64) -> Result<(), DynamicsError> {
+        if *steps >= self.options.max_steps {
+            return Err(DynamicsError::StepBudget {
+                t: self.state.t,
+                steps: *steps,
+            });
+        }
+        *steps += 1;
+        Ok(())
     }
 
     /// A target time must be finite and not behind.

@@ -30,14 +30,16 @@ pub enum StepControl {
 }
 
 impl Default for StepControl {
-    /// Error-controlled: `rtol` 1e-6, `atol` 1e-9, first step 1e-4, steps from 1e-12 up.
+    /// Error-controlled: `rtol` 1e-6, `atol` 1e-9, first step 1e-4, steps from 1e-12 up to
+    /// 0.1 (where the error estimate vanishes, at rest or under a constant force, the steps
+    /// would otherwise grow without bound and stride over time-dependent loads).
     fn default() -> Self {
         Self::Adaptive {
             rtol: 1e-6,
             atol: 1e-9,
             initial: 1e-4,
             min: 1e-12,
-            max: f64::INFINITY,
+            max: 0.1,
         }
     }
 }
@@ -54,9 +56,14 @@ pub struct IntegratorOptions {
     /// Newton iterations per step (default 8) before the matrix is refreshed or the step
     /// fails.
     pub max_iterations: u32,
-    /// The Newton iteration stops when the correction it would apply moves no free coordinate
-    /// by more than this, in units of the scene's length scale for lengths and in radians for
-    /// angles (default 1e-10).
+    /// Steps one call to [`crate::Integrator::step_to`] or [`crate::Integrator::run`] may take
+    /// before it stops with [`DynamicsError::StepBudget`] (default 10⁷), so that a run whose
+    /// tolerance or span asks for more never looks like a hang.
+    pub max_steps: u64,
+    /// The Newton iteration stops when the correction it would apply changes no free
+    /// acceleration by more than this times the largest free acceleration (each in units of
+    /// the scene's length scale, or radians; accelerations too small to move the state over
+    /// the step count as zero) (default 1e-10).
     pub newton_tolerance: f64,
 }
 
@@ -66,6 +73,7 @@ impl Default for IntegratorOptions {
             rho_inf: 0.9,
             control: StepControl::default(),
             max_iterations: 8,
+            max_steps: 10_000_000,
             newton_tolerance: 1e-10,
         }
     }
@@ -84,6 +92,9 @@ impl IntegratorOptions {
         }
         if self.max_iterations == 0 {
             return bad("max_iterations", 0.0);
+        }
+        if self.max_steps == 0 {
+            return bad("max_steps", 0.0);
         }
         if !positive(self.newton_tolerance) {
             return bad("newton_tolerance", self.newton_tolerance);
