@@ -137,6 +137,7 @@ where
         self.earlier_step = h;
         core::mem::swap(&mut self.state, &mut self.trial);
         core::mem::swap(&mut self.now, &mut self.next);
+        self.reduced.accepted.copy_from(&self.reduced.v);
         let m = self.solver.mechanism();
         self.book.advance(m, &self.state, &self.reduced.forces, h);
         self.stats.steps += 1;

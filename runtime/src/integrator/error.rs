@@ -31,9 +31,10 @@ pub enum DynamicsError {
         error: SolveError,
     },
     /// The step reached or crossed a singular configuration of the partition (the sign of
-    /// det Φ_q changed, or `∂q/∂u` grew a thousandfold): the coordinates the free degrees of freedom name cannot carry the mechanism
-    /// through it (a slider's position at a crank's dead centre: the crank angle can). Declare
-    /// another coordinate free.
+    /// det Φ_q changed, `∂q/∂u` grew a thousandfold, or the coordinates' velocities kinked as
+    /// on the reflected motion): the coordinates the free degrees of freedom name cannot carry
+    /// the mechanism through it (a slider's position at a crank's dead centre: the crank angle
+    /// can). Declare another coordinate free.
     Toggle {
         /// Time of the step's end.
         t: f64,

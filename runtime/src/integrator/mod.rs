@@ -23,6 +23,7 @@ mod error;
 mod newton;
 mod options;
 mod reduced;
+mod toggle;
 
 pub use energy::Energy;
 pub use error::{DescribedDynamics, DynamicsError};
@@ -225,6 +226,7 @@ where
         solved.map_err(|failure| self.failure(failure, t, 0.0))?;
         self.next.a.copy_from(&self.next.udd);
         self.sensitivity = self.reduced.v.norm();
+        self.reduced.accepted.copy_from(&self.reduced.v);
         self.earlier_step = 0.0;
         core::mem::swap(&mut self.state, &mut self.trial);
         core::mem::swap(&mut self.now, &mut self.next);

@@ -31,13 +31,10 @@ const MASS_TOLERANCE: f64 = 1e-12;
 const CONTRACTION: f64 = 0.5;
 /// Accelerations below this many scene scales per step squared count as zero for the
 /// relative Newton test (a state at rest).
-const ACCELERATION_FLOOR: f64 = 1e-6;
+pub(super) const ACCELERATION_FLOOR: f64 = 1e-6;
 /// The share of the iteration matrix (largest scaled entries) above which stiffness and
 /// damping make a step stiff.
 const STIFF_SHARE: f64 = 0.5;
-/// How far `‖V‖` may grow past its value at the start before the state counts as at a
-/// toggle of the partition: the reduced mass then grew about a million times.
-const TOGGLE_GROWTH: f64 = 1e3;
 /// A correction that stalls within this factor of the tolerance (with a fresh matrix) is the
 /// residual's round-off: the iterate is accepted.
 const STALL: f64 = 100.0;
@@ -87,8 +84,9 @@ where
     inverse: OMatrix<f64, F, F>,
     /// The residual of the last correction, and Broyden's scratch.
     last: OVector<f64, F>,
-    change: OVector<f64, F>,
-    row: OVector<f64, F>,
+    /// Scratch of Broyden's update and of the toggle check.
+    pub change: OVector<f64, F>,
+    pub row: OVector<f64, F>,
     /// The free coordinates' unit scales (lengths to the scene's length scale).
     pub scales: OVector<f64, F>,
     /// The step size the inverse is for; `None` without one.
@@ -228,46 +226,58 @@ where
     pub(super) fn solve_step(&mut self, h: f64, t: f64) -> Result<(), Failure> {
         self.predict(h)?;
         let tolerance = self.options.newton_tolerance;
+        // Whether the matrix was rebuilt in this step; the last correction, and the last one
+        // a matrix made at the iterate where it was rebuilt.
         let mut fresh = false;
-        let mut previous = f64::INFINITY;
+        let (mut previous, mut rebuilt_size) = (f64::INFINITY, f64::INFINITY);
         for iteration in 1..=self.options.max_iterations {
             self.stats.iterations += 1;
             self.next.advance(&self.now, &self.alpha, h);
             self.evaluate(t)?;
-            // Whether V is this iterate's (a refresh solves for it).
-            let mut solved_v = false;
+            // Whether the matrix (and V) is this iterate's.
+            let mut rebuilt = false;
             if self.matrix.step != Some(h) || !self.matrix.built {
                 self.refresh(h)?;
-                (fresh, solved_v) = (true, true);
+                rebuilt = true;
             } else if iteration > 1 && previous > UPDATE_ABOVE * tolerance {
                 self.matrix.update(&self.correction, &self.reduced.residual);
             }
             let mut size = self.correct(h)?;
-            if size > CONTRACTION * previous && !fresh {
+            if size > CONTRACTION * previous && !fresh && !rebuilt {
                 // Slow: the kept matrix is too far from this iterate's; rebuild it here.
                 self.refresh(h)?;
-                (fresh, solved_v) = (true, true);
+                rebuilt = true;
                 size = self.correct(h)?;
             }
+            fresh |= rebuilt;
             // Converged; or, with a fresh matrix, stalled at the residual's round-off (a stiff
             // spring amplifies the positions' rounding into forces) within reach of it.
             let stalled = fresh && size > CONTRACTION * previous && size <= STALL * tolerance;
             if size <= tolerance || stalled {
-                return self.finish(solved_v);
+                return self.finish(rebuilt, h);
             }
-            if size >= previous && fresh {
-                return Err(Failure::NoConvergence {
+            // Diverging: a rebuilt matrix's correction is measured against the last rebuilt
+            // one's, not against the old matrix's (which may have overshot), so that it is
+            // tried.
+            let reference = if rebuilt { rebuilt_size } else { previous };
+            if size >= reference && fresh {
+                let failure = Failure::NoConvergence {
                     iterations: iteration,
                     residual: size,
-                });
+                };
+                return Err(self.diagnose(h, failure));
+            }
+            if rebuilt {
+                rebuilt_size = size;
             }
             self.next.udd += &self.correction;
             previous = size;
         }
-        Err(Failure::NoConvergence {
+        let failure = Failure::NoConvergence {
             iterations: self.options.max_iterations,
             residual: previous,
-        })
+        };
+        Err(self.diagnose(h, failure))
     }
 
     /// Starts a step from a prediction of `ü_{n+1}`: in the stiff regime the linearly implicit
@@ -330,14 +340,14 @@ where
     }
 
     /// Completes the converged iterate in `trial`: its `V` (unless `solved_v`) and `F`, then
-    /// the toggle check.
-    fn finish(&mut self, solved_v: bool) -> Result<(), Failure> {
+    /// the toggle checks.
+    fn finish(&mut self, solved_v: bool, h: f64) -> Result<(), Failure> {
         if !solved_v {
             self.solve_v()?;
         }
         let m = self.solver.mechanism();
         self.reduced.measure_forces(m, &self.trial);
-        self.check_crossing()
+        self.check_crossing(h)
     }
 
     /// `V` at the last evaluation (`next`, solved into `trial`).
@@ -346,28 +356,6 @@ where
         self.reduced
             .sensitivities(&mut self.solver, t, &self.next, &self.trial)
             .map_err(Failure::Kinematics)
-    }
-
-    /// The converged state is on the same side of every singular configuration as the
-    /// current one (the sign of det Φ_q and of each block's determinant): otherwise the free
-    /// motion crossed a toggle of its partition, where the kinematic solve lands on the
-    /// mirror branch.
-    ///
-    /// Nor may it come close to one: near a toggle of the partition `V = ∂q/∂u` grows without
-    /// bound (the free coordinate stalls while the mechanism moves on), and the reduced
-    /// equations there have a second, reflected solution on which the kinematic solve may stay
-    /// without any sign changing. A state whose `‖V‖` grew [`TOGGLE_GROWTH`] times past its
-    /// value at the start counts as reaching the toggle.
-    fn check_crossing(&self) -> Result<(), Failure> {
-        let (before, after) = (&self.state, &self.trial);
-        let same_side =
-            before.orientation == after.orientation && before.block_signs == after.block_signs;
-        let near = self.reduced.v.norm() > TOGGLE_GROWTH * self.sensitivity;
-        if same_side && !near {
-            Ok(())
-        } else {
-            Err(Failure::Toggle)
-        }
     }
 
     /// Evaluates the residual at `next`, into `trial`.

@@ -28,6 +28,8 @@ where
 {
     /// `V = ∂q/∂u`, one column per free degree of freedom, where last solved for.
     pub v: OMatrix<f64, M::Dim, M::Free>,
+    /// `V` at the current (accepted) state.
+    pub accepted: OMatrix<f64, M::Dim, M::Free>,
     /// `F = Q − M q̈`, where last computed.
     pub forces: Vector<M::Dim>,
     /// `R = Vᵀ F` at the last evaluation.
@@ -48,6 +50,7 @@ where
     fn clone(&self) -> Self {
         Self {
             v: self.v.clone(),
+            accepted: self.accepted.clone(),
             forces: self.forces.clone(),
             residual: self.residual.clone(),
             rows: self.rows.clone(),
@@ -79,6 +82,7 @@ where
         let (n, f) = (m.dim(), m.free());
         Self {
             v: OMatrix::zeros_generic(n, f),
+            accepted: OMatrix::zeros_generic(n, f),
             forces: Vector::zeros_generic(n, U1),
             residual: OVector::zeros_generic(f, U1),
             rows: OVector::from_fn_generic(f, U1, |k, _| m.free_equation(k)),
