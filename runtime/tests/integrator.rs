@@ -498,7 +498,8 @@ fn a_toggle_met_by_the_free_motion_is_a_typed_error() {
                 integrator.t() <= toggle + 1e-4 && t > toggle - 1e-4,
                 "{t} vs {toggle}"
             );
-            assert_eq!(step, h);
+            // The step the clock takes: h to rounding.
+            assert!((step - h).abs() <= 1e-12 * h, "{step} vs {h}");
         } else {
             // Stopped by the growth of ‖V‖ (a thousandfold where |sin θ| is a thousandth of
             // its start's: measured 0.19 ms before the toggle).
