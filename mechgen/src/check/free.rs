@@ -220,6 +220,30 @@ mod tests {
         }
     }
 
+    /// The mobility count speaks of free degrees of freedom in a scene that has them.
+    #[test]
+    fn the_mobility_count_names_free_degrees_of_freedom() {
+        let many =
+            errors("free swing: angle(arm) from 0.3; free spin: angle(arm); gravity (0, -9.8);");
+        assert!(
+            many.iter().any(
+                |m| m.starts_with("too many drivers and free degrees of freedom")
+                    && m.contains("remove 1, such as `spin`")
+            ),
+            "{many:?}"
+        );
+        let few = errors(
+            "body bob near (0, -2, 0) mass 1; joint hinge: revolute(arm @ (0.8, 0), bob @ (0, 1));
+             free swing: angle(arm); gravity (0, -9.8);",
+        );
+        assert!(
+            few.iter()
+                .any(|m| m.contains("drivers and free degrees of freedom")
+                    && m.contains("e.g. `free spin: angle(arm);`")),
+            "{few:?}"
+        );
+    }
+
     #[test]
     fn a_scene_without_masses_is_refused_at_the_first_free() {
         let source = "mechanism M { ground frame at (0, 0, 0); body arm near (1, 0, 0);

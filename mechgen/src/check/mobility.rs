@@ -155,8 +155,15 @@ impl Checker {
             })
             .find(|name| !taken(name))
             .unwrap_or_default();
-        self.errors.push(
-            spec.name.span(),
+        // A scene that moves under forces is told of `free`, one that is driven of `driver`.
+        let message = if has_free(spec) {
+            format!(
+                "`{}` has {dof} degree{} of freedom but {drivers} drivers and free degrees of \
+                 freedom ({count}); add {missing} more, e.g. `free {spin}: angle({example});`",
+                spec.name,
+                plural(dof),
+            )
+        } else {
             format!(
                 "`{}` has {dof} degree{} of freedom but {drivers} driver{} ({count}); add \
                  {missing} driver{}, e.g. `driver {spin}: angle({example}) = t;`",
@@ -164,8 +171,9 @@ impl Checker {
                 plural(dof),
                 plural(drivers),
                 plural(missing),
-            ),
-        );
+            )
+        };
+        self.errors.push(spec.name.span(), message);
     }
 
     /// More drivers than degrees of freedom: the error at each driver past the count.
@@ -173,8 +181,15 @@ impl Checker {
         let drivers = spec.drivers.len() as i64;
         let extra = drivers - dof;
         for driver in spec.drivers.iter().skip(dof as usize) {
-            self.errors.push(
-                driver.name.span(),
+            let message = if has_free(spec) {
+                format!(
+                    "too many drivers and free degrees of freedom: `{}` has {dof} degree{} of \
+                     freedom but {drivers} ({count}); remove {extra}, such as `{}`",
+                    spec.name,
+                    plural(dof),
+                    driver.name,
+                )
+            } else {
                 format!(
                     "too many drivers: `{}` has {dof} degree{} of freedom but {drivers} \
                      driver{} ({count}); remove {extra} driver{}, such as `{}`",
@@ -183,8 +198,9 @@ impl Checker {
                     plural(drivers),
                     plural(extra),
                     driver.name,
-                ),
-            );
+                )
+            };
+            self.errors.push(driver.name.span(), message);
         }
     }
 
@@ -310,4 +326,9 @@ fn removable_joints<'a>(
         .iter()
         .filter_map(|&k| spec.joints.get(k.checked_sub(ground)?).map(|j| &j.name))
         .collect()
+}
+
+/// Whether the scene declares free degrees of freedom (which count with its drivers).
+fn has_free(spec: &Spec) -> bool {
+    spec.drivers.iter().any(|d| d.free_keyword().is_some())
 }

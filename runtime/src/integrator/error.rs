@@ -174,7 +174,7 @@ impl DynamicsError {
                 f,
                 "the Newton iteration of the step to t = {t} (h = {step:e}) did not converge in \
                  {iterations} iterations (last scaled correction {residual:e}): take a smaller \
-                 step or raise max_iterations"
+                 step (or, if the corrections were still shrinking, raise max_iterations)"
             ),
             Self::SingularMass { t, free: k, .. } => {
                 write!(f, "at t = {t} free degree of freedom ")?;
