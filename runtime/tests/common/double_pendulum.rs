@@ -11,7 +11,7 @@ use mechgen_runtime::codegen::math::{cos, sin};
 use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{
     Accelerations, Dynamic, EnergyTerms, EquationsOfMotion, Forces, Matrix, Mechanism, Names,
-    Outputs, ParameterError, Unit, Vector, Velocities,
+    Outputs, Unit, Vector, Velocities,
 };
 
 type Q = Vector<Const<6>>;
@@ -92,29 +92,12 @@ impl Mechanism for DoublePendulum {
     fn dim(&self) -> Const<6> {
         Const
     }
-    fn marker_storage(&self) -> [f64; 0] {
-        []
-    }
+    no_parameters_or_markers!();
     fn coordinate_name(&self, index: usize) -> Option<&str> {
         COORDINATES.get(index).copied()
     }
     fn equation_name(&self, index: usize) -> Option<&str> {
         EQUATIONS.get(index).copied()
-    }
-    fn parameter_count(&self) -> usize {
-        0
-    }
-    fn parameter_name(&self, _: usize) -> Option<&str> {
-        None
-    }
-    fn parameter(&self, _: usize) -> Option<f64> {
-        None
-    }
-    fn set_parameter<'a>(&'a mut self, name: &'a str, _: f64) -> Result<(), ParameterError<'a>> {
-        Err(ParameterError::Unknown {
-            name,
-            declared: &[] as &[&str; 0],
-        })
     }
     fn coordinate_unit(&self, index: usize) -> Unit {
         if index % 3 == 2 {

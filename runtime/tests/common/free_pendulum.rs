@@ -11,7 +11,7 @@ use mechgen_runtime::codegen::math::{cos, sin};
 use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{
     Accelerations, Dynamic, EnergyTerms, EquationsOfMotion, Forces, Matrix, Mechanism, Names,
-    Outputs, ParameterError, Unit, Vector, Velocities,
+    Outputs, Unit, Vector, Velocities,
 };
 
 type Q = Vector<Const<3>>;
@@ -89,29 +89,12 @@ impl Mechanism for FreePendulum {
     fn dim(&self) -> Const<3> {
         Const
     }
-    fn marker_storage(&self) -> [f64; 0] {
-        []
-    }
+    no_parameters_or_markers!();
     fn coordinate_name(&self, index: usize) -> Option<&str> {
         COORDINATES.get(index).copied()
     }
     fn equation_name(&self, index: usize) -> Option<&str> {
         EQUATIONS.get(index).copied()
-    }
-    fn parameter_count(&self) -> usize {
-        0
-    }
-    fn parameter_name(&self, _: usize) -> Option<&str> {
-        None
-    }
-    fn parameter(&self, _: usize) -> Option<f64> {
-        None
-    }
-    fn set_parameter<'a>(&'a mut self, name: &'a str, _: f64) -> Result<(), ParameterError<'a>> {
-        Err(ParameterError::Unknown {
-            name,
-            declared: &[] as &[&str; 0],
-        })
     }
     fn coordinate_unit(&self, index: usize) -> Unit {
         if index < 2 { Unit::Length } else { Unit::Angle }
@@ -245,7 +228,7 @@ pub struct DynFreePendulum(pub FreePendulum);
 mod dynamic {
     use super::{
         Accelerations, DynFreePendulum, Dynamic, EnergyTerms, EquationsOfMotion, Forces, Mechanism,
-        Names, Outputs, ParameterError, Q, Unit, Vector, Velocities,
+        Names, Outputs, Q, Unit, Vector, Velocities,
     };
     use mechgen_runtime::Matrix;
     use mechgen_runtime::nalgebra::{Dyn, Matrix3};
@@ -271,33 +254,12 @@ mod dynamic {
         fn dim(&self) -> Dyn {
             Dyn(3)
         }
-        fn marker_storage(&self) -> [f64; 0] {
-            []
-        }
+        no_parameters_or_markers!();
         fn coordinate_name(&self, index: usize) -> Option<&str> {
             self.0.coordinate_name(index)
         }
         fn equation_name(&self, index: usize) -> Option<&str> {
             self.0.equation_name(index)
-        }
-        fn parameter_count(&self) -> usize {
-            0
-        }
-        fn parameter_name(&self, _: usize) -> Option<&str> {
-            None
-        }
-        fn parameter(&self, _: usize) -> Option<f64> {
-            None
-        }
-        fn set_parameter<'a>(
-            &'a mut self,
-            name: &'a str,
-            _: f64,
-        ) -> Result<(), ParameterError<'a>> {
-            Err(ParameterError::Unknown {
-                name,
-                declared: &[] as &[&str; 0],
-            })
         }
         fn coordinate_unit(&self, index: usize) -> Unit {
             self.0.coordinate_unit(index)

@@ -11,7 +11,7 @@
 use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{
     Accelerations, Dynamic, EnergyTerms, EquationsOfMotion, Forces, Matrix, Mechanism, Outputs,
-    ParameterError, Unit, Velocities,
+    Unit, Velocities,
 };
 
 use super::slider_crank::{COORDINATES, EQUATIONS, Q, SliderCrank};
@@ -94,9 +94,7 @@ impl Mechanism for FreeSliderCrank {
     type Dim = Const<9>;
     type Markers = [f64; 0];
 
-    fn marker_storage(&self) -> [f64; 0] {
-        []
-    }
+    no_parameters_or_markers!();
     fn dim(&self) -> Const<9> {
         Const
     }
@@ -109,21 +107,6 @@ impl Mechanism for FreeSliderCrank {
         } else {
             EQUATIONS.get(index).copied()
         }
-    }
-    fn parameter_count(&self) -> usize {
-        0
-    }
-    fn parameter_name(&self, _: usize) -> Option<&str> {
-        None
-    }
-    fn parameter(&self, _: usize) -> Option<f64> {
-        None
-    }
-    fn set_parameter<'a>(&'a mut self, name: &'a str, _: f64) -> Result<(), ParameterError<'a>> {
-        Err(ParameterError::Unknown {
-            name,
-            declared: &[] as &[&str; 0],
-        })
     }
     fn coordinate_unit(&self, index: usize) -> Unit {
         self.kinematics(0.0).coordinate_unit(index)

@@ -6,6 +6,35 @@
 // Not every test binary uses every fixture.
 #![allow(dead_code)]
 
+/// The `Mechanism` methods of a fixture without parameters or markers (declared before the
+/// fixtures' modules, which use it inside their `impl Mechanism`).
+macro_rules! no_parameters_or_markers {
+    () => {
+        fn marker_storage(&self) -> [f64; 0] {
+            []
+        }
+        fn parameter_count(&self) -> usize {
+            0
+        }
+        fn parameter_name(&self, _: usize) -> Option<&str> {
+            None
+        }
+        fn parameter(&self, _: usize) -> Option<f64> {
+            None
+        }
+        fn set_parameter<'a>(
+            &'a mut self,
+            name: &'a str,
+            _: f64,
+        ) -> Result<(), mechgen_runtime::ParameterError<'a>> {
+            Err(mechgen_runtime::ParameterError::Unknown {
+                name,
+                declared: &[] as &[&str; 0],
+            })
+        }
+    };
+}
+
 pub mod cart_pendulum;
 pub mod double_pendulum;
 pub mod free_pendulum;
