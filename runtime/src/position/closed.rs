@@ -13,7 +13,7 @@
 //! answers and its errors there are unchanged: at a toggle Newton crawls into the singular root
 //! and reports it, where a start on the exact root would converge at once and hide it.
 
-use core::f64::consts::TAU;
+use core::f64::consts::{PI, TAU};
 
 use nalgebra::DefaultAllocator;
 
@@ -50,32 +50,31 @@ where
     let mut out = [f64::NAN; 2 * MAX_SIZE];
     bs.m.closed_form(bs.stage, q, parts.trig, t, &mut out[..2 * n]);
     let coordinates = bs.block.coordinates;
-    for candidate in out[..2 * n].chunks_exact_mut(n) {
-        for (value, &c) in candidate.iter_mut().zip(coordinates) {
-            if bs.m.coordinate_unit(c) == Unit::Angle {
-                *value += TAU * libm::round((q[c] - *value) / TAU);
+    // Per coordinate: the guess, its scale, and each candidate moved to the guess's turn;
+    // then the squared scaled distances from the guess to each candidate and between them.
+    let (mut to_first, mut to_second, mut apart) = (0.0, 0.0, 0.0);
+    for (j, (&c, &scale)) in coordinates
+        .iter()
+        .zip(&*parts.scales.inverse_cols)
+        .enumerate()
+    {
+        let guess = q[c];
+        let angle = bs.m.coordinate_unit(c) == Unit::Angle;
+        let [first, second] = [j, n + j].map(|k| {
+            let value = out[k];
+            // atan2 answers within a turn and a half of 0: most guesses need no rounding.
+            if angle && (guess - value).abs() > PI {
+                out[k] = value + TAU * libm::round((guess - value) / TAU);
             }
-        }
+            out[k]
+        });
+        let [d1, d2, d12] = [first - guess, second - guess, first - second].map(|d| d * scale);
+        (to_first, to_second, apart) = (to_first + d1 * d1, to_second + d2 * d2, apart + d12 * d12);
     }
-    let scaled = &*parts.scales.inverse_cols;
-    let (first, second) = out[..2 * n].split_at(n);
-    // Squared scaled distances, compared squared.
-    let distance = |a: &[f64], b: &dyn Fn(usize) -> f64| -> f64 {
-        let terms = a.iter().zip(scaled).enumerate();
-        terms
-            .map(|(j, (&v, &s))| {
-                let d = (v - b(j)) * s;
-                d * d
-            })
-            .sum()
-    };
-    let to_first = distance(first, &|j| q[coordinates[j]]);
-    let to_second = distance(second, &|j| q[coordinates[j]]);
-    let apart = distance(first, &|j| second[j]);
     let (nearest, near, far) = if to_first <= to_second {
-        (first, to_first, to_second)
+        (0, to_first, to_second)
     } else {
-        (second, to_second, to_first)
+        (n, to_second, to_first)
     };
     // Only a guess well inside the nearest solution's neighbourhood takes it, and only away
     // from a toggle: where the solutions merge, Newton's own choice from the guess stands, as
@@ -88,7 +87,7 @@ where
     if !(unique || clear) {
         return false;
     }
-    for (&value, &c) in nearest.iter().zip(coordinates) {
+    for (&value, &c) in out[nearest..nearest + n].iter().zip(coordinates) {
         q[c] = value;
     }
     true
