@@ -23,6 +23,12 @@
 //! closed form plus its Newton–Euler elimination (`mechgen_examples::inverse_dynamics`) and
 //! against the kinematic seed step of the same run.
 //!
+//! The closed-form groups (issue 23): `{scene}/default` times the steps a user takes (a
+//! `Simulation` over `Solver::new`, default options, every safeguard on) and `{scene}/newton`
+//! the same with `SolverOptions::closed_forms` off, for the seed, the four-bar, Hoeken's
+//! linkage, the quick-return (`quick_return/written_out`: its closed form written out by hand)
+//! and the posed offset slider; the last table compares them with the written-out closed forms.
+//!
 //! After criterion's figures, the run prints each scene's fastest batch per step for
 //! `closed_form`, `generated` and `dense`, and their ratios: fastest batches, because the
 //! machines are shared and noise only ever adds time.
@@ -34,10 +40,12 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{BenchmarkGroup, Criterion, measurement::WallTime};
-use mechgen_examples::closed_form;
 use mechgen_examples::inverse_dynamics::{MassProperties, seed_reactions};
 use mechgen_examples::report::{AutoDiff, CentralDifference, ForwardDifference, Plan};
-use mechgen_examples::scenes::{FourBar, OffsetSlider, PistonCrank, PistonCrankDynamics};
+use mechgen_examples::scenes::{
+    FourBar, Hoeken, OffsetSlider, PistonCrank, PistonCrankDynamics, QuickReturn,
+};
+use mechgen_examples::{closed_form, written_out};
 use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{
@@ -148,6 +156,22 @@ where
     DefaultAllocator: Storage<M::Dim>,
 {
     let options = Plan::full().reference.options();
+    driven_with(c, fastest, label, mechanism, period, options);
+}
+
+/// [`driven`] with the solver's `options`.
+fn driven_with<M>(
+    c: &mut Criterion,
+    fastest: &Fastest,
+    label: &str,
+    mechanism: M,
+    period: f64,
+    options: SolverOptions,
+) where
+    M: Structured + Clone,
+    M::Workspace: Clone,
+    DefaultAllocator: Storage<M::Dim>,
+{
     let checkpoint = Simulation::new(Solver::with_options(mechanism.clone(), options), 0.0)
         .expect("scene assembles");
     let mut group = c.benchmark_group(label);
@@ -213,15 +237,39 @@ fn closed<F: Clone, R>(
     group.finish();
 }
 
-/// The offset slider posed at the next of [`STEPS`] crank angles, warm-started from the last
-/// solve (its positions-only, time-free use).
-fn posed<M>(c: &mut Criterion, fastest: &Fastest, label: &str, mechanism: M, pose: fn(&mut M, f64))
+/// A scene's steps as a user takes them (`Solver::new`: default options, every safeguard on)
+/// under `{scene}/default`, and the same on Newton's path alone (closed-form groups off) under
+/// `{scene}/newton`: what the closed forms save, measured in the same run.
+fn closed_forms<M>(c: &mut Criterion, fastest: &Fastest, scene: &str, mechanism: M, period: f64)
 where
     M: Structured + Clone,
     M::Workspace: Clone,
     DefaultAllocator: Storage<M::Dim>,
 {
-    let mut solver = Solver::with_options(mechanism.clone(), Plan::full().reference.options());
+    for (method, closed_forms) in [("default", true), ("newton", false)] {
+        let options = SolverOptions {
+            closed_forms,
+            ..SolverOptions::default()
+        };
+        let label = format!("{scene}/{method}");
+        driven_with(c, fastest, &label, mechanism.clone(), period, options);
+    }
+}
+
+/// The offset slider posed at the next of [`STEPS`] crank angles, warm-started from the last
+/// solve (its positions-only, time-free use).
+fn posed<M>(
+    c: &mut Criterion,
+    fastest: &Fastest,
+    (label, options): (&str, SolverOptions),
+    mechanism: M,
+    pose: fn(&mut M, f64),
+) where
+    M: Structured + Clone,
+    M::Workspace: Clone,
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let mut solver = Solver::with_options(mechanism.clone(), options);
     let mut state = State::new(solver.mechanism());
     solver.mechanism().initial_guess(&mut state.q);
     pose(solver.mechanism_mut(), 0.0);
@@ -299,6 +347,7 @@ fn seed(c: &mut Criterion, fastest: &Fastest) {
         },
     );
     driven(c, fastest, "seed/generated", seed, period);
+    closed_forms(c, fastest, "seed", seed, period);
     solver_steps(c, fastest, "seed/generated_solver", seed, period);
     driven(c, fastest, "seed/dense", Dense::new(seed), period);
     driven(
@@ -387,6 +436,7 @@ fn four_bar(c: &mut Criterion, fastest: &Fastest) {
         },
     );
     driven(c, fastest, "four_bar/generated", four_bar, period);
+    closed_forms(c, fastest, "four_bar", four_bar, period);
     solver_steps(c, fastest, "four_bar/generated_solver", four_bar, period);
     driven(c, fastest, "four_bar/dense", Dense::new(four_bar), period);
     let forward = Dense::new(ForwardDifference::new(four_bar));
@@ -416,21 +466,93 @@ fn offset_slider(c: &mut Criterion, fastest: &Fastest) {
         |f, theta| f.q(theta),
     );
     let pose = |m: &mut OffsetSlider, theta: f64| m.crank_angle = theta;
+    let reference = Plan::full().reference.options();
+    let slider = OffsetSlider::default();
     posed(
         c,
         fastest,
-        "offset_slider/generated",
-        OffsetSlider::default(),
+        ("offset_slider/generated", reference),
+        slider,
         pose,
     );
+    for (method, closed_forms) in [("default", true), ("newton", false)] {
+        let options = SolverOptions {
+            closed_forms,
+            ..SolverOptions::default()
+        };
+        let label = format!("offset_slider/{method}");
+        posed(c, fastest, (&label, options), slider, pose);
+    }
     let pose_dense = |m: &mut Dense<OffsetSlider>, theta: f64| m.inner_mut().crank_angle = theta;
+    let dense = Dense::new(slider);
     posed(
         c,
         fastest,
-        "offset_slider/dense",
-        Dense::new(OffsetSlider::default()),
+        ("offset_slider/dense", reference),
+        dense,
         pose_dense,
     );
+}
+
+/// Hoeken's linkage (a four-bar with a long coupler): its closed-form group on and off.
+fn hoeken(c: &mut Criterion, fastest: &Fastest) {
+    let hoeken = Hoeken::default();
+    let period = 2.0 * std::f64::consts::PI / hoeken.omega;
+    closed_forms(c, fastest, "hoeken", hoeken, period);
+}
+
+/// The crank and slotted lever quick-return (a slot, then a link and ram: two closed-form
+/// groups) against its written-out closed form.
+fn quick_return(c: &mut Criterion, fastest: &Fastest) {
+    let form = written_out::QuickReturn::default();
+    let period = form.period();
+    closed(
+        c,
+        fastest,
+        "quick_return/written_out",
+        form,
+        period / STEPS as f64,
+        |f, t| {
+            let mut step = ([0.0; 15], [0.0; 15], [0.0; 15]);
+            f.written_out(t, &mut step);
+            step
+        },
+    );
+    closed_forms(c, fastest, "quick_return", QuickReturn::default(), period);
+}
+
+/// The closed-form groups' table: each scene's step as a user takes it (default options),
+/// against the written-out closed form where there is one and against Newton's path alone.
+fn closed_form_summary(fastest: &Fastest) {
+    println!("\nclosed-form groups, default options (fastest batch per step, ns):");
+    println!(
+        "  {:<15} {:>11} {:>9} {:>8} {:>9} {:>8} {:>9}",
+        "scene", "written out", "default", "×", "Newton", "×", "saved"
+    );
+    for scene in [
+        "seed",
+        "four_bar",
+        "hoeken",
+        "quick_return",
+        "offset_slider",
+    ] {
+        let time = |method: &str| fastest.get(&format!("{scene}/{method}"));
+        let (Some(default), Some(newton)) = (time("default"), time("newton")) else {
+            continue;
+        };
+        let hand = time("written_out");
+        let cell = |t: f64| match hand {
+            Some(hand) => format!("{:>9.1} {:>8.2}", t * 1e9, t / hand),
+            None => format!("{:>9.1} {:>8}", t * 1e9, "—"),
+        };
+        let hand = hand.map_or("—".to_owned(), |h| format!("{:.1}", h * 1e9));
+        println!(
+            "  {scene:<15} {hand:>11} {} {} {:>8.0} %",
+            cell(default),
+            cell(newton),
+            100.0 * (1.0 - default / newton)
+        );
+    }
 }
 
 /// The ratio table: fastest batch per step against the scene's closed form, and the
@@ -511,7 +633,10 @@ fn main() {
     seed_forces(&mut c, &fastest);
     four_bar(&mut c, &fastest);
     offset_slider(&mut c, &fastest);
+    hoeken(&mut c, &fastest);
+    quick_return(&mut c, &fastest);
     safeguards(&mut c, &fastest);
     c.final_summary();
     summary(&fastest);
+    closed_form_summary(&fastest);
 }

@@ -235,3 +235,35 @@ mechanism! {
         marker output: angle(frame, carrier);
     }
 }
+
+mechanism! {
+    /// Crank and slotted lever quick-return (a shaper's drive), units mm, rad, s.
+    ///
+    /// The crank's pin slides in a slot along the lever, which pivots 100 below the crank; the
+    /// lever's tip drives the ram along a horizontal guide through a link. The lever swings
+    /// through 2 asin(0.4) while the crank turns: its return stroke is the quicker.
+    pub mechanism QuickReturn {
+        /// Crank speed (rad/s).
+        param omega = 10.0;
+
+        /// Frame (fixed), with the crank pivot at its origin.
+        ground frame at (0, 0, 0);
+        /// Crank, its pin 40 from the pivot.
+        body crank near (0, 0, 0);
+        /// Slotted lever, 220 long, pivoting at its reference point.
+        body lever near (0, -100, 1.19);
+        /// Link, 120 long, from the lever's tip to the ram.
+        body link near (82, 104, 0.22);
+        /// Ram, sliding 130 above the crank pivot.
+        body ram near (199, 130, 0);
+
+        joint crank_pivot: revolute(frame, crank);
+        joint lever_pivot: revolute(frame @ (0, -100), lever);
+        joint pin: slot(lever, crank @ (40, 0), along (1, 0));
+        joint tip: revolute(lever @ (220, 0), link);
+        joint ram_pin: revolute(link @ (120, 0), ram);
+        joint guide: prismatic(frame @ (0, 130), ram, along (1, 0));
+
+        driver crank_angle: angle(crank) = omega * t;
+    }
+}

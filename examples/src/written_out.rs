@@ -1,6 +1,6 @@
-//! The seed piston-crank and the crank-rocker four-bar written out by hand: positions,
-//! velocities and accelerations in closed form, every derivative derived on paper, no dual
-//! numbers, no iteration. This is the strongest baseline a generated solver can be measured
+//! The seed piston-crank, the crank-rocker four-bar and the quick-return written out by hand:
+//! positions, velocities and accelerations in closed form, every derivative derived on paper,
+//! no dual numbers, no iteration. This is the strongest baseline a generated solver can be measured
 //! against (what an engineer would write for one mechanism), and the benchmark's reference.
 //!
 //! The seed needs one `sin_cos` (the crank), one `sqrt` (the piston pin on its line) and one
@@ -9,8 +9,12 @@
 //! intersection) and two `atan2`s; its rates come from the loop equation
 //! `a e^{iθ₂} + b e^{iθ₃} − c e^{iθ₄} − d = 0` solved for `ω₃, ω₄`, then `α₃, α₄`.
 //!
-//! Coordinates and branches are those of [`crate::closed_form`], which checks these formulas
-//! (tests in `tests/tests/written_out.rs`).
+//! The quick-return ([`QuickReturn`], the scene `quick_return.mech`) needs one `sin_cos`, two
+//! `sqrt`s and two `atan2`s (lever and link).
+//!
+//! Coordinates and branches are those of [`crate::closed_form`], which checks the seed's and
+//! the four-bar's formulas; the quick-return's are checked against the generated solve, with
+//! and without its closed-form groups (tests in `tests/tests/written_out.rs`).
 
 use crate::closed_form::{FourBar, PistonCrank};
 
@@ -187,6 +191,106 @@ impl FourBar {
             0.0,
             0.0,
             alpha4,
+        ];
+    }
+}
+
+/// The crank and slotted lever quick-return of `examples/scenes/quick_return.mech`: its
+/// dimensions (mm, rad/s), with positions, velocities and accelerations written out by hand.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuickReturn {
+    /// Crank speed.
+    pub omega: f64,
+    /// Crank pin's distance from the crank pivot.
+    pub crank: f64,
+    /// Lever pivot's distance below the crank pivot.
+    pub drop: f64,
+    /// Lever length, pivot to tip.
+    pub lever: f64,
+    /// Link length, lever tip to ram.
+    pub link: f64,
+    /// The ram's guide's height above the crank pivot.
+    pub ram_height: f64,
+}
+
+impl Default for QuickReturn {
+    fn default() -> Self {
+        QuickReturn {
+            omega: 10.0,
+            crank: 40.0,
+            drop: 100.0,
+            lever: 220.0,
+            link: 120.0,
+            ram_height: 130.0,
+        }
+    }
+}
+
+impl QuickReturn {
+    /// One crank revolution.
+    pub fn period(&self) -> f64 {
+        core::f64::consts::TAU / self.omega
+    }
+
+    /// `q`, `q̇`, `q̈` at time `t` (crank at `ω t`, the lever pointing at the pin, the ram to
+    /// the right of the lever's tip).
+    pub fn written_out(&self, t: f64, out: &mut Step<15>) {
+        let (w, r, h) = (self.omega, self.crank, self.drop);
+        let phi = w * t;
+        let (sin, cos) = phi.sin_cos();
+        // The pin from the lever's pivot, d = P − O, and its rates (φ̈ = 0).
+        let (dx, dy) = (r * cos, r * sin + h);
+        let (vx, vy) = (-r * sin * w, r * cos * w);
+        let (ax, ay) = (-r * cos * w * w, -r * sin * w * w);
+        // The lever points along d: θ̇ = (d × ḋ)/|d|², θ̈ = (d × d̈)/|d|² − 2 θ̇ (d · ḋ)/|d|².
+        let d2 = dx * dx + dy * dy;
+        let theta = dy.atan2(dx);
+        let theta_d = (dx * vy - dy * vx) / d2;
+        let theta_dd = (dx * ay - dy * ax) / d2 - 2.0 * theta_d * (dx * vx + dy * vy) / d2;
+        let d = d2.sqrt();
+        let (c, s) = (dx / d, dy / d);
+        // The tip T = O + L (c, s).
+        let l = self.lever;
+        let (tx, ty) = (l * c, -h + l * s);
+        let (tx_d, ty_d) = (-l * s * theta_d, l * c * theta_d);
+        let td2 = theta_d * theta_d;
+        let tx_dd = -l * (s * theta_dd + c * td2);
+        let ty_dd = l * (c * theta_dd - s * td2);
+        // The link: T_y + k sin ψ = height, cos ψ > 0; ψ̇ = −Ṫ_y/(k cos ψ),
+        // ψ̈ = (−T̈_y + k sin ψ ψ̇²)/(k cos ψ).
+        let k = self.link;
+        let sin_psi = (self.ram_height - ty) / k;
+        let cos_psi = (1.0 - sin_psi * sin_psi).sqrt();
+        let psi = sin_psi.atan2(cos_psi);
+        let psi_d = -ty_d / (k * cos_psi);
+        let psi_dd = (-ty_dd + k * sin_psi * psi_d * psi_d) / (k * cos_psi);
+        // The ram, x = T_x + k cos ψ.
+        let x = tx + k * cos_psi;
+        let x_d = tx_d - k * sin_psi * psi_d;
+        let x_dd = tx_dd - k * (cos_psi * psi_d * psi_d + sin_psi * psi_dd);
+        let (q, qd, qdd) = out;
+        *q = [
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            phi,
+            0.0,
+            -h,
+            theta,
+            tx,
+            ty,
+            psi,
+            x,
+            self.ram_height,
+            0.0,
+        ];
+        *qd = [
+            0.0, 0.0, 0.0, 0.0, 0.0, w, 0.0, 0.0, theta_d, tx_d, ty_d, psi_d, x_d, 0.0, 0.0,
+        ];
+        *qdd = [
+            0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, theta_dd, tx_dd, ty_dd, psi_dd, x_dd, 0.0, 0.0,
         ];
     }
 }

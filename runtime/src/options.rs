@@ -94,6 +94,10 @@ pub struct SolverOptions {
     /// `max_condition` is not checked and states report a NaN condition: only for measuring
     /// what the estimate costs.
     pub estimate_condition: bool,
+    /// Start each block that has a closed form (`Structured::closed_form`) from its solution
+    /// nearest the guess (default true); Newton then verifies it. Off, Newton starts from the
+    /// guess itself: only for comparing the two paths.
+    pub closed_forms: bool,
 }
 
 impl Default for SolverOptions {
@@ -110,6 +114,7 @@ impl Default for SolverOptions {
             max_step: 1.0,
             scale_units: true,
             estimate_condition: true,
+            closed_forms: true,
         }
     }
 }

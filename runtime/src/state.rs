@@ -79,6 +79,9 @@ where
     /// Block factorisations whose static pivots were too small and were redone with partial
     /// pivoting (see [`crate::SolverOptions::static_pivot_threshold`]), summed over sub-steps.
     pub fallbacks: usize,
+    /// Blocks the last position solve started from their closed-form solution
+    /// ([`crate::Convergence::closed_forms`]).
+    pub closed_forms: usize,
     /// The sign of det Φ_q at `q` (unit-scaled, in the scene's solve order): +1 or −1. Two
     /// states of one motion with different signs have a singular configuration (a toggle or
     /// change point) between them ([`crate::Convergence::orientation`]).
@@ -181,6 +184,7 @@ where
             condition: f64::NAN,
             evaluations: 0,
             fallbacks: 0,
+            closed_forms: 0,
             orientation: 1,
             block_signs: 0,
             swept: false,
@@ -205,6 +209,7 @@ where
         self.condition = other.condition;
         self.evaluations = other.evaluations;
         self.fallbacks = other.fallbacks;
+        self.closed_forms = other.closed_forms;
         self.orientation = other.orientation;
         self.block_signs = other.block_signs;
         self.swept = other.swept;
@@ -391,6 +396,7 @@ where
             condition: self.condition,
             evaluations: self.evaluations,
             fallbacks: self.fallbacks,
+            closed_forms: self.closed_forms,
             orientation: self.orientation,
             block_signs: self.block_signs,
             swept: self.swept,
@@ -417,6 +423,7 @@ where
             .field("condition", &self.condition)
             .field("evaluations", &self.evaluations)
             .field("fallbacks", &self.fallbacks)
+            .field("closed_forms", &self.closed_forms)
             .field("orientation", &self.orientation)
             .field("outputs", &self.outputs)
             .finish()

@@ -160,6 +160,22 @@ where
         values: &mut [f64],
     );
 
+    /// Writes a block's two solutions in closed form, where the generator found them (a loop
+    /// that closes by a circle–line or circle–circle intersection): the block's coordinates in
+    /// local column order, candidate-major, into `out` (twice the block's length), from the
+    /// earlier stages' positions in `q`. NaN where the loop cannot close. An angle may differ
+    /// from the solution wanted by whole turns. Blocks without a closed form leave `out` as it
+    /// is (the solver fills it with NaN first): the default, for scenes without any.
+    fn closed_form(
+        &self,
+        _stage: usize,
+        _q: &Vector<Self::Dim>,
+        _trig: &[f64],
+        _t: f64,
+        _out: &mut [f64],
+    ) {
+    }
+
     /// Writes the sines and cosines of the angles stage `stage` solved into the trig cache, once
     /// its positions in `q` are final.
     fn fill_trig(&self, _stage: usize, _q: &Vector<Self::Dim>, _trig: &mut [f64]) {}

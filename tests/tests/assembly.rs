@@ -104,8 +104,10 @@ fn flat_guesses_take_the_branch_the_scene_declares() {
 fn a_guess_newton_does_not_finish_from_names_the_equation_whose_bodies_to_move() {
     // One update is not enough from the four-bar's guesses: "not found from this guess", with
     // the loop equation left furthest from closing, whose joint's bodies are the ones to move.
+    // (Newton's path: from its closed form, the four-bar's loop closes in one update.)
     let options = SolverOptions {
         max_iterations: 1,
+        closed_forms: false,
         ..SolverOptions::default()
     };
     let failure = Simulation::new(Solver::with_options(FourBar::default(), options), 0.0)

@@ -57,3 +57,51 @@ fn the_four_bar_written_out_matches_its_closed_form_over_a_revolution() {
         }
     }
 }
+
+/// The quick-return's written-out kinematics against the generated solve of its scene, with its
+/// two closed-form groups (the slotted lever, the link and ram) and on Newton's path alone: an
+/// independent derivation of both, to round-off, over two revolutions stepped 360 times each.
+#[test]
+fn the_quick_return_written_out_matches_the_solver_with_and_without_closed_forms() {
+    use mechgen_examples::scenes::QuickReturn as Scene;
+    use mechgen_examples::written_out::QuickReturn;
+    use mechgen_runtime::{Simulation, Solver, SolverOptions};
+
+    let hand = QuickReturn::default();
+    let mut out = ([0.0; 15], [0.0; 15], [0.0; 15]);
+    for closed_forms in [true, false] {
+        let options = SolverOptions {
+            closed_forms,
+            ..SolverOptions::default()
+        };
+        let solver = Solver::with_options(Scene::default(), options);
+        let mut simulation = Simulation::new(solver, 0.0).unwrap_or_else(|e| panic!("{e}"));
+        let mut started = 0;
+        for i in 1..=720 {
+            let t = hand.period() * f64::from(i) / 360.0;
+            let state = simulation.step_to(t).unwrap_or_else(|e| panic!("{e}"));
+            hand.written_out(t, &mut out);
+            let levels = [
+                (state.q.as_slice(), &out.0, 220.0),
+                (state.qd().as_slice(), &out.1, 220.0 * hand.omega),
+                (
+                    state.qdd().as_slice(),
+                    &out.2,
+                    220.0 * hand.omega * hand.omega,
+                ),
+            ];
+            for (level, (solved, written, scale)) in levels.into_iter().enumerate() {
+                for (k, (a, b)) in solved.iter().zip(written.iter()).enumerate() {
+                    let error = (a - b).abs() / scale;
+                    assert!(
+                        error < 1e-12,
+                        "closed forms {closed_forms}, t {t}, level {level}, q[{k}]: {a} vs {b}"
+                    );
+                }
+            }
+            started += state.closed_forms;
+        }
+        let expected = if closed_forms { 2 * 720 } else { 0 };
+        assert_eq!(started, expected, "closed forms {closed_forms}");
+    }
+}

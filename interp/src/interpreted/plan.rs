@@ -290,6 +290,22 @@ impl Structured for Interpreted {
         }
     }
 
+    fn closed_form(&self, stage: usize, q: &Vector<Dyn>, trig: &[f64], t: f64, out: &mut [f64]) {
+        let outputs = [(Buffer::Candidates, out.len())];
+        match self
+            .plan
+            .find(stage, Method::ClosedForm, [trig.len(), 0], &outputs)
+        {
+            Found::Kernel(kernel) => {
+                self.evaluate(kernel, self.inputs_with(q.as_slice(), &[], &[], trig, t));
+                self.scatter(kernel, Buffer::Candidates, out);
+            }
+            Found::Short => out.fill(f64::NAN),
+            // Without a kernel, generated code leaves the candidates alone (the trait's default).
+            Found::Elsewhere | Found::Nowhere => {}
+        }
+    }
+
     fn block_jacobian(
         &self,
         stage: usize,

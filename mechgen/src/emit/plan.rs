@@ -32,10 +32,11 @@ enum Lu {
 }
 
 /// The methods in the order generated code lists them.
-const ITEMS: [Item; 12] = [
+const ITEMS: [Item; 13] = [
     Item::Kernel(Method::Positions),
     Item::Kernel(Method::Velocities),
     Item::Kernel(Method::Accelerations),
+    Item::Kernel(Method::ClosedForm),
     Item::Kernel(Method::Jacobian),
     Item::Kernel(Method::FillTrig),
     Item::Lu(Lu::Factor),
@@ -122,6 +123,7 @@ fn name_of(item: Item) -> &'static str {
         Item::Kernel(Method::Positions) => "assign_positions",
         Item::Kernel(Method::Velocities) => "assign_velocities",
         Item::Kernel(Method::Accelerations) => "assign_accelerations",
+        Item::Kernel(Method::ClosedForm) => "closed_form",
         Item::Kernel(Method::Jacobian) => "block_jacobian",
         Item::Kernel(Method::VelocityRhs) => "velocity_rhs",
         Item::Kernel(Method::AccelerationRhs) => "acceleration_rhs",
@@ -148,6 +150,7 @@ fn signature(item: Item) -> (Vec<(&'static str, TokenStream)>, Option<TokenStrea
         Item::Kernel(Method::Positions) => vec![("q", mut_vector), trig, t],
         Item::Kernel(Method::Velocities) => vec![q, trig, ("qd", mut_vector), t],
         Item::Kernel(Method::Accelerations) => vec![q, trig, qd, ("qdd", mut_vector), t],
+        Item::Kernel(Method::ClosedForm) => vec![q, trig, t, out],
         Item::Kernel(Method::Jacobian) => {
             vec![
                 q,
@@ -267,6 +270,10 @@ fn naming(method: Method) -> (&'static str, &'static str) {
         Method::Positions => ("positions", "assigns the positions"),
         Method::Velocities => ("velocities", "assigns the velocities"),
         Method::Accelerations => ("accelerations", "assigns the accelerations"),
+        Method::ClosedForm => (
+            "closed_form",
+            "the block's two solutions in closed form (Newton's starting points)",
+        ),
         Method::Jacobian => ("jacobian", "the block's residual and Jacobian values"),
         Method::VelocityRhs => ("velocity_rhs", "the block's velocity right-hand side"),
         Method::AccelerationRhs => (
@@ -335,13 +342,19 @@ fn kernel_dispatch(
                     #call;
                 }
             }
-            Method::VelocityRhs | Method::AccelerationRhs | Method::ForceRhs => quote! {
-                let #some(out) = out.first_chunk_mut::<#equations>() else {
-                    out.fill(f64::NAN);
-                    return;
-                };
-                #call;
-            },
+            Method::ClosedForm
+            | Method::VelocityRhs
+            | Method::AccelerationRhs
+            | Method::ForceRhs => {
+                let len = len(method.target());
+                quote! {
+                    let #some(out) = out.first_chunk_mut::<#len>() else {
+                        out.fill(f64::NAN);
+                        return;
+                    };
+                    #call;
+                }
+            }
         };
         dispatch.push(k.stage, arm, &kernel.arguments);
     }

@@ -464,6 +464,7 @@ impl Arena {
                 self.fold_or(value, Node::Div(a, b))
             }
             _ if b == self.one => a,
+            _ if self.as_const(b) == Some(-1.0) => self.neg(a),
             _ if self.is_zero(a) && !self.is_zero(b) => self.zero,
             _ if a == b && self.as_const(a).is_none() => self.one,
             _ => self.intern(Node::Div(a, b)),

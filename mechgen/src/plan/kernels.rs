@@ -31,6 +31,8 @@ pub enum Method {
     Velocities,
     /// An explicit stage's accelerations, written to `qdd`.
     Accelerations,
+    /// A block's two closed-form solutions (to `out`, candidate-major), where it has them.
+    ClosedForm,
     /// A block's residuals (to `phi`) and Jacobian values (to `values`, in pattern order).
     Jacobian,
     /// A block's velocity right-hand side, to `out`.
@@ -47,10 +49,11 @@ pub enum Method {
 
 impl Method {
     /// Every method, in kernel order.
-    pub const ALL: [Method; 9] = [
+    pub const ALL: [Method; 10] = [
         Method::Positions,
         Method::Velocities,
         Method::Accelerations,
+        Method::ClosedForm,
         Method::Jacobian,
         Method::VelocityRhs,
         Method::AccelerationRhs,
@@ -64,7 +67,9 @@ impl Method {
     /// rates also from its own, the force solve from every stage.
     pub fn phase(self) -> Phase {
         match self {
-            Method::Positions | Method::Jacobian | Method::FillTrig => Phase::Positions,
+            Method::Positions | Method::ClosedForm | Method::Jacobian | Method::FillTrig => {
+                Phase::Positions
+            }
             Method::Velocities
             | Method::Accelerations
             | Method::VelocityRhs
@@ -76,7 +81,9 @@ impl Method {
     /// The state its kernels may read besides the trig cache and time.
     pub fn inputs(self) -> &'static [Input] {
         match self {
-            Method::Positions | Method::Jacobian | Method::FillTrig => &[Input::Q],
+            Method::Positions | Method::ClosedForm | Method::Jacobian | Method::FillTrig => {
+                &[Input::Q]
+            }
             Method::Velocities | Method::VelocityRhs => &[Input::Q, Input::Qd],
             Method::Accelerations | Method::AccelerationRhs => &[Input::Q, Input::Qd, Input::Qdd],
             Method::Multipliers | Method::ForceRhs => {
@@ -91,6 +98,7 @@ impl Method {
             Method::Positions => Buffer::Q,
             Method::Velocities => Buffer::Qd,
             Method::Accelerations => Buffer::Qdd,
+            Method::ClosedForm => Buffer::Candidates,
             Method::Jacobian => Buffer::Values,
             Method::VelocityRhs | Method::AccelerationRhs | Method::ForceRhs => Buffer::Out,
             Method::FillTrig => Buffer::Trig,
@@ -143,6 +151,8 @@ pub enum Buffer {
     Values,
     /// A right-hand side or a list of values, from 0.
     Out,
+    /// A block's closed-form candidates: two solutions of its coordinates, from 0.
+    Candidates,
 }
 
 impl Buffer {
@@ -156,7 +166,7 @@ impl Buffer {
             Buffer::Trig => "trig",
             Buffer::Phi => "phi",
             Buffer::Values => "values",
-            Buffer::Out => "out",
+            Buffer::Out | Buffer::Candidates => "out",
         }
     }
 }
@@ -289,6 +299,7 @@ impl Kernels {
             Buffer::Q | Buffer::Qd | Buffer::Qdd | Buffer::Lambda => self.sizes.coordinates,
             Buffer::Trig => self.sizes.trig,
             Buffer::Phi | Buffer::Out => shape.map_or(0, |s| s.equations.len()),
+            Buffer::Candidates => shape.map_or(0, |s| 2 * s.equations.len()),
             Buffer::Values => shape.and_then(|s| s.block.as_ref()).map_or(0, |b| b.slots),
         }
     }
@@ -424,7 +435,8 @@ fn level_drafts(assignments: &[Assignment]) -> Vec<(Method, Draft)> {
         .collect()
 }
 
-/// A block's residuals then Jacobian values, and its rate right-hand sides.
+/// A block's residuals then Jacobian values, its closed-form candidates if it has them, and
+/// its rate right-hand sides.
 fn block_drafts(block: &Block) -> Vec<(Method, Draft)> {
     let roots = block
         .residuals
@@ -437,6 +449,12 @@ fn block_drafts(block: &Block) -> Vec<(Method, Draft)> {
         .chain((0..block.entries.len()).map(|k| (Buffer::Values, k)))
         .collect();
     let mut kernels = vec![(Method::Jacobian, (roots, outputs))];
+    if let Some(closed) = &block.closed {
+        let outputs = (0..closed.candidates.len())
+            .map(|k| (Buffer::Candidates, k))
+            .collect();
+        kernels.push((Method::ClosedForm, (closed.candidates.clone(), outputs)));
+    }
     let rates = [
         (Method::VelocityRhs, &block.velocity_rhs),
         (Method::AccelerationRhs, &block.acceleration_rhs),
@@ -567,7 +585,10 @@ mod tests {
                     // Written out per method, not read from `Method::phase`: the rule itself
                     // is what is tested.
                     let allowed = match k.method {
-                        Method::Positions | Method::Jacobian | Method::FillTrig => filled < k.stage,
+                        Method::Positions
+                        | Method::ClosedForm
+                        | Method::Jacobian
+                        | Method::FillTrig => filled < k.stage,
                         Method::Velocities
                         | Method::Accelerations
                         | Method::VelocityRhs
@@ -641,6 +662,12 @@ mod tests {
                 ) => {
                     assert_eq!(k.kernel.roots.len(), block.equations.len());
                 }
+                (Stage::Block(block), Method::ClosedForm) => {
+                    let closed = block.closed.as_ref().expect("a block with a closed form");
+                    assert_eq!(k.kernel.roots, closed.candidates);
+                    assert_eq!(k.kernel.roots.len(), 2 * block.equations.len());
+                    assert!(k.kernel.outputs.iter().all(|o| o.0 == Buffer::Candidates));
+                }
                 (_, Method::FillTrig) => {
                     let trig = &scene.kernels.trig;
                     let slots: Vec<usize> = trig
@@ -675,7 +702,7 @@ mod tests {
         let positions = scene(OFFSET_SLIDER);
         assert!(positions.kernels.stages.iter().all(|k| matches!(
             k.method,
-            Method::Positions | Method::Jacobian | Method::FillTrig
+            Method::Positions | Method::ClosedForm | Method::Jacobian | Method::FillTrig
         )));
         assert_eq!(positions.kernels.sizes.forces, None);
         let forces = scene(DYNAMICS);

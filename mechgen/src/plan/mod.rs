@@ -1,8 +1,9 @@
 //! Planning the solve, once per scene at generation time: the stages that decide the
-//! coordinates ([`structure`]), the force solve that runs them in reverse ([`reactions`]), the
+//! coordinates ([`structure`]) and the blocks among them solved in closed form ([`closed`]), the force solve that runs them in reverse ([`reactions`]), the
 //! planned [`Scene`] that the emitter and the interpreter read, its equations of motion
 //! ([`motion`]), and its operation counts ([`stats`]).
 
+pub mod closed;
 pub mod kernels;
 pub mod motion;
 pub mod reactions;

@@ -7,6 +7,7 @@ use std::fmt;
 use crate::expr::tape::topological_order;
 use crate::expr::{Arena, Func, Id, Node};
 use crate::plan::Scene;
+use crate::plan::closed::ClosedKind;
 use crate::plan::structure::{Assignment, Block, Plan, Stage};
 
 /// How many operations of each kind a straight-line evaluation performs (each DAG node once).
@@ -209,7 +210,7 @@ pub fn structure(scene: &Scene) -> String {
     let (coordinates, equations) = (model.coordinate_names(), model.equation_names());
     let mut out = summary(scene);
     out += &format!(
-        "{:>6}  {:<9}{:>5}{:>9}{:>6}{:>9}  solves (coordinate ← equation)\n",
+        "{:>6}  {:<13}{:>5}{:>9}{:>6}{:>9}  solves (coordinate ← equation)\n",
         "stage", "kind", "size", "entries", "fill", "updates"
     );
     let count = plan.stages.len();
@@ -282,6 +283,7 @@ fn summary(scene: &Scene) -> String {
             "s"
         },
     );
+    out += &closed_summary(&blocks);
     if scene.forces.is_some() {
         out += &format!(
             "force solve, stages in reverse: {explicit} multipliers in closed form, {in_blocks} by \
@@ -290,6 +292,42 @@ fn summary(scene: &Scene) -> String {
         );
     }
     out
+}
+
+/// "closed form: 2 of 3 blocks (1 circle–line, 1 circle–circle), Newton verifies", or nothing
+/// for a scene without blocks.
+fn closed_summary(blocks: &[&Block]) -> String {
+    if blocks.is_empty() {
+        return String::new();
+    }
+    let kinds = [
+        ClosedKind::CircleLine,
+        ClosedKind::CircleCircle,
+        ClosedKind::Linear,
+    ];
+    let counts: Vec<String> = kinds
+        .iter()
+        .filter_map(|&kind| {
+            let n = (blocks.iter())
+                .filter(|b| b.closed.as_ref().is_some_and(|c| c.kind == kind))
+                .count();
+            (n > 0).then(|| format!("{n} {}", kind.name()))
+        })
+        .collect();
+    let closed = blocks.iter().filter(|b| b.closed.is_some()).count();
+    let detail = if counts.is_empty() {
+        String::new()
+    } else {
+        format!(
+            " ({}), each started there and verified by Newton",
+            counts.join(", ")
+        )
+    };
+    format!(
+        "closed form: {closed} of {} block{}{detail}\n",
+        blocks.len(),
+        if blocks.len() == 1 { "" } else { "s" }
+    )
 }
 
 /// One stage's line of the table.
@@ -316,7 +354,7 @@ fn stage_line(
             let es: Vec<usize> = a.iter().map(|a| a.equation).collect();
             let kind = if fixed(arena, a) { "fixed" } else { "explicit" };
             format!(
-                "{s:>6}  {kind:<9}{:>5}{:>9}{:>6}{:>9}  {}\n",
+                "{s:>6}  {kind:<13}{:>5}{:>9}{:>6}{:>9}  {}\n",
                 a.len(),
                 "",
                 "",
@@ -333,9 +371,10 @@ fn stage_line(
                 ),
                 None => (b.entries.len().to_string(), "-".into(), "dense".into()),
             };
+            // A block with a closed form is named by its kind; Newton only verifies it.
+            let kind = b.closed.as_ref().map_or("block", |c| c.kind.name());
             format!(
-                "{s:>6}  {:<9}{:>5}{e:>9}{f:>6}{u:>9}  {}\n",
-                "block",
+                "{s:>6}  {kind:<13}{:>5}{e:>9}{f:>6}{u:>9}  {}\n",
                 b.equations.len(),
                 pairs(&b.coordinates, &b.equations)
             )

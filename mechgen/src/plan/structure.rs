@@ -16,7 +16,8 @@
 //! 4. **Newton blocks** for every other component, each with a static LU (`factor`) whose pivot
 //!    order is chosen here at the scene's initial guess, and the right-hand sides of its
 //!    velocity and acceleration solves: `ν_b − Φ_q[b, earlier] q̇_earlier`, and the same with γ
-//!    and q̈.
+//!    and q̈. A block whose loop closes by an intersection (a dyad) also gets its solution
+//!    in closed form ([`closed`]), which starts its Newton iteration.
 //!
 //! Rates that turn out constant (a ground body's zero velocity, a driver's ω) are substituted
 //! forward as well, so the generated code does no work for them.
@@ -28,6 +29,7 @@ use crate::expr::tape::{Inputs, Tape};
 use crate::expr::{Arena, Id, Var, var_index};
 use crate::model::kinematics::Kinematics;
 use crate::model::{Model, Outputs};
+use crate::plan::closed::{self, ClosedForm};
 use crate::sparse::factor::{self, Factorization};
 use crate::sparse::graph;
 
@@ -90,6 +92,8 @@ pub struct Block {
     pub velocity_rhs: Option<Vec<Id>>,
     /// `γ_b − Φ_q[b, earlier] q̈_earlier`, in row order, if it computes accelerations.
     pub acceleration_rhs: Option<Vec<Id>>,
+    /// Its solution in closed form, if its loop closes by an intersection ([`closed`]).
+    pub closed: Option<Box<ClosedForm>>,
 }
 
 impl Block {
@@ -241,6 +245,7 @@ pub fn single_block(kin: &Kinematics) -> Plan {
             factorization: None,
             velocity_rhs: kin.nu.clone(),
             acceleration_rhs: kin.gamma.clone(),
+            closed: None,
         })],
         reads: vec![Vec::new()],
     }
@@ -538,7 +543,7 @@ impl Planner<'_> {
         let positions: Vec<(usize, usize)> = entries.iter().map(|&(r, c, _)| (r, c)).collect();
         let factorization =
             Some(Factorization::new(n, &positions)).filter(|f| f.updates() <= MAX_STATIC_UPDATES);
-        let residuals = equations.iter().map(|&i| phi[i]).collect();
+        let residuals: Vec<Id> = equations.iter().map(|&i| phi[i]).collect();
         let velocity_rhs = (self.outputs >= Outputs::Velocities).then(|| {
             equations
                 .iter()
@@ -557,6 +562,7 @@ impl Planner<'_> {
                 })
                 .collect()
         });
+        let closed = closed::recognize(self.arena, &coordinates, &residuals).map(Box::new);
         Block {
             equations,
             coordinates,
@@ -565,6 +571,7 @@ impl Planner<'_> {
             factorization,
             velocity_rhs,
             acceleration_rhs,
+            closed,
         }
     }
 

@@ -21,10 +21,12 @@
 //! Jacobian moved by less than its own rounding); otherwise the block is evaluated and factored
 //! once more at the returned positions.
 //!
-//! One concept per file: the Newton iteration (`newton.rs`), its Levenberg–Marquardt fallback
+//! One concept per file: the Newton iteration (`newton.rs`), its start from a closed-form
+//! solution where the block has one (`closed.rs`), its Levenberg–Marquardt fallback
 //! (`marquardt.rs`), the errors and the diagnosis of a failed solve (`failure.rs`), and the
 //! scaled norms (`norms.rs`); the tuning constants they share are here.
 
+mod closed;
 mod failure;
 mod marquardt;
 mod newton;

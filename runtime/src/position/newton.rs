@@ -3,6 +3,7 @@
 
 use nalgebra::DefaultAllocator;
 
+use super::closed;
 use super::marquardt::Marquardt;
 use super::norms::{max_abs, scaled_max, scaled_max_iter, scaled_norms};
 use super::{
@@ -56,6 +57,8 @@ pub(crate) struct Newton<'a, 'w, M> {
     orientation: f64,
     /// The side a stationary point is left by first ([`Newton::escape`]): +1 or −1.
     pub escape_side: f64,
+    /// Whether the iteration started from the block's closed-form solution.
+    pub closed_form: bool,
 }
 
 impl<'a, 'w, M: Structured> Newton<'a, 'w, M>
@@ -79,6 +82,7 @@ where
             signs: (false, false),
             orientation: 1.0,
             escape_side: 1.0,
+            closed_form: false,
         }
     }
 
@@ -93,6 +97,8 @@ where
     /// decreasing above the tolerance; [`SolveError::Unresolved`] when the corrections reached
     /// the rounding of the coordinates but the residual stayed above `acceptance_tolerance`;
     /// [`SolveError::NoConvergence`] after `max_iterations`.
+    ///
+    /// A block with a closed form starts from its solution nearest `q` ([`closed::start`]).
     pub fn solve(
         &mut self,
         q: &mut Vector<M::Dim>,
@@ -110,6 +116,9 @@ where
         let mut marquardt = Marquardt::default();
         // The step last applied: merit at `base` and the fraction of the step taken.
         let mut pending: Option<(f64, f64)> = None;
+        if options.closed_forms {
+            self.closed_form = closed::start(&self.bs, self.parts, q, self.t);
+        }
         loop {
             let factored = self.evaluate(q);
             self.check_phi()?;

@@ -226,6 +226,7 @@ where
         state.condition = convergence.condition;
         state.evaluations = convergence.evaluations;
         state.fallbacks = convergence.fallbacks;
+        state.closed_forms = convergence.closed_forms;
         state.orientation = convergence.orientation;
         state.block_signs = convergence.block_signs;
         state.swept = convergence.swept;

@@ -40,6 +40,8 @@ pub struct Convergence {
     /// Whether a block's Newton iterates met both determinant signs: the iteration crossed
     /// a singular configuration between its start and the solution.
     pub swept: bool,
+    /// Blocks whose Newton iteration started from their closed-form solution.
+    pub closed_forms: usize,
 }
 
 impl Convergence {
@@ -53,11 +55,13 @@ impl Convergence {
             orientation: 1,
             block_signs: 0,
             swept: false,
+            closed_forms: 0,
         }
     }
 
-    pub(super) fn add(&mut self, stage: usize, block: &Solved, newton: (usize, usize)) {
-        let (fallbacks, evaluations) = newton;
+    pub(super) fn add(&mut self, stage: usize, block: &Solved, newton: (usize, usize, bool)) {
+        let (fallbacks, evaluations, closed_form) = newton;
+        self.closed_forms += usize::from(closed_form);
         self.iterations = self.iterations.max(block.iterations);
         self.residual = self.residual.max(block.residual);
         // NaN (estimate off) stays NaN.

@@ -103,7 +103,8 @@ where
                     let solved = newton
                         .solve(q, rates != Rates::None)
                         .map_err(|e| record(e, m, s, newton.parts, diagnosed))?;
-                    total.add(s, &solved, (newton.fallbacks, newton.evaluations));
+                    let counts = (newton.fallbacks, newton.evaluations, newton.closed_form);
+                    total.add(s, &solved, counts);
                     rounding.block::<M>(block.coordinates, newton.parts.scales.inverse_cols, q);
                     m.fill_trig(s, q, newton.parts.trig);
                     block_rates(
