@@ -154,7 +154,8 @@ proptest! {
     ) {
         prop_assume!(crank_rocker(a, b, c, d));
         let s = size(exponent);
-        let scene = FourBar { a: a * s, b: b * s, c: c * s, d: d * s, omega, phase, ..FourBar::default() };
+        let (a, b, c, d) = (a * s, b * s, c * s, d * s);
+        let scene = FourBar { a, b, c, d, omega, phase, ..FourBar::default() };
         let length = scene.b.max(scene.c).max(scene.d);
         for sign in [1.0, -1.0] {
             let motion = exact::four_bar(&scene, sign);
@@ -162,7 +163,8 @@ proptest! {
                 let t = fraction * TAU / omega;
                 let want = exact::at(&motion, t);
                 let guess = guess_near(&scene, length, &want.q, &moves, SPREAD);
-                check_instant(&format!("four-bar {scene:?}, branch {sign}"), &scene, length, t, &guess, &want);
+                let what = format!("four-bar {scene:?}, branch {sign}");
+                check_instant(&what, &scene, length, t, &guess, &want);
             }
         }
     }
@@ -180,7 +182,8 @@ proptest! {
     ) {
         prop_assume!(e.abs() + r < 0.8 * l);
         let s = size(exponent);
-        let scene = OffsetSlider { r: r * s, l: l * s, e: e * s, omega, phase, ..OffsetSlider::default() };
+        let (r, l, e) = (r * s, l * s, e * s);
+        let scene = OffsetSlider { r, l, e, omega, phase, ..OffsetSlider::default() };
         let length = scene.l;
         for side in [1.0, -1.0] {
             let motion = exact::offset_slider(&scene, side);
@@ -188,7 +191,8 @@ proptest! {
                 let t = fraction * TAU / omega;
                 let want = exact::at(&motion, t);
                 let guess = guess_near(&scene, length, &want.q, &moves, SPREAD);
-                check_instant(&format!("offset slider {scene:?}, side {side}"), &scene, length, t, &guess, &want);
+                let what = format!("offset slider {scene:?}, side {side}");
+                check_instant(&what, &scene, length, t, &guess, &want);
             }
         }
     }
@@ -224,7 +228,8 @@ proptest! {
                 let t = fraction * TAU / omega;
                 let want = exact::at(&motion, t);
                 let guess = guess_near(&scene, length, &want.q, &moves, SPREAD);
-                check_instant(&format!("piston-crank {scene:?}, side {side}"), &scene, length, t, &guess, &want);
+                let what = format!("piston-crank {scene:?}, side {side}");
+                check_instant(&what, &scene, length, t, &guess, &want);
             }
         }
     }
@@ -242,7 +247,8 @@ proptest! {
         moves in prop::collection::vec(-1.0_f64..1.0, 9),
     ) {
         let s = size(exponent);
-        let scene = Collar { size: 4.0 * s, phase, swing, omega, reach: reach * s, stroke: stroke * s, nu };
+        let (reach, stroke) = (reach * s, stroke * s);
+        let scene = Collar { size: 4.0 * s, phase, swing, omega, reach, stroke, nu };
         let length = scene.size;
         let motion = exact::collar(&scene);
         for &fraction in &times {
@@ -265,12 +271,14 @@ proptest! {
         let s = size(exponent);
         // Between the dead centres l − r and l + r, clear of both.
         let start = (l - r + 2.0 * r * position) * s;
-        let scene = PushedSlider { r: r * s, l: l * s, start, speed: speed * s, ..PushedSlider::default() };
+        let (r, l, speed) = (r * s, l * s, speed * s);
+        let scene = PushedSlider { r, l, start, speed, ..PushedSlider::default() };
         let length = scene.l + scene.r;
         for sign in [1.0, -1.0] {
             let want = exact::at(exact::pushed_slider(&scene, sign), 0.0);
             let guess = guess_near(&scene, length, &want.q, &moves, SPREAD / 3.0);
-            check_instant(&format!("pushed slider {scene:?}, branch {sign}"), &scene, length, 0.0, &guess, &want);
+            let what = format!("pushed slider {scene:?}, branch {sign}");
+            check_instant(&what, &scene, length, 0.0, &guess, &want);
         }
     }
 }
@@ -333,7 +341,8 @@ proptest! {
             let newton = solve(&scene, false, t, &states[k].q).unwrap();
             prop_assert_eq!(closed.closed_forms, 1, "the dyad alone, t = {}", t);
             prop_assert_eq!(newton.closed_forms, 0);
-            assert_within(&format!("six-bar, t = {t}"), between(&scene, length, &closed, &newton), ROUND_OFF);
+            let what = format!("six-bar, t = {t}");
+            assert_within(&what, between(&scene, length, &closed, &newton), ROUND_OFF);
             let phi = residual(&scene, length, &closed.q, t);
             prop_assert!(phi <= 1e-13, "Φ = {:e} scene lengths at t = {}", phi, t);
         }

@@ -62,10 +62,11 @@ twin! {
 
 twin! {
     pub PISTON_CRANK,
-    /// The seed's piston-crank with its dimensions as parameters (crank pin at crank @ (0, `radius`),
-    /// rod @ (`rod_pin`, 0) on it, rod @ (0, `rod_length`) at the piston pin piston @ (−`pin`, 0),
-    /// the liner's axis `offset` above the bearing): the 2×2 block (rod.y, rod.theta), rod.y
-    /// eliminated first (CircleLine). The rod guesses pick the piston's side.
+    /// The seed's piston-crank with its dimensions as parameters (crank pin at
+    /// crank @ (0, `radius`), rod @ (`rod_pin`, 0) on it, rod @ (0, `rod_length`) at the piston
+    /// pin piston @ (−`pin`, 0), the liner's axis `offset` above the bearing): the 2×2 block
+    /// (rod.y, rod.theta), rod.y eliminated first (CircleLine). The rod guesses pick the
+    /// piston's side.
     pub mechanism PistonCrank {
         param radius = 43;
         param rod_pin = 41.3;

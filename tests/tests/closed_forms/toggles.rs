@@ -122,7 +122,11 @@ where
 
 proptest! {
     // Failures are not persisted: proptest finds no crate root beside a submodule's file.
-    #![proptest_config(ProptestConfig { cases: 24, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig {
+        cases: 24,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
 
     /// Lengths in whole units of a power of two, so that the dead centres r + l and l − r are
     /// exact and the loop closes there exactly (a zero discriminant, not a rounded one).
@@ -141,15 +145,18 @@ proptest! {
         let scene = |start: f64| PushedSlider { r, l, start, speed: r, ..PushedSlider::default() };
         for sign in [1.0, -1.0] {
             let what = format!("r = {r}, l = {l}, dead centre {centre}, branch {sign}");
-            let guess = exact::at(exact::pushed_slider(&scene(centre + inward * 0.02 * r), sign), 0.0).q;
+            let far = scene(centre + inward * 0.02 * r);
+            let guess = exact::at(exact::pushed_slider(&far, sign), 0.0).q;
             near(&what, length, &guess, |distance| {
                 let close = scene(centre + inward * distance * length);
                 let want = exact::at(exact::pushed_slider(&close, sign), 0.0);
                 (close, 0.0, want)
             });
             at(&format!("{what}, at"), &scene(centre), length, 0.0, &guess);
-            beyond(&format!("{what}, just beyond"), &scene(centre - inward * NEAR[2] * length), 0.0, &guess);
-            beyond(&format!("{what}, beyond"), &scene(centre - inward * BEYOND * length), 0.0, &guess);
+            for (past, how) in [(NEAR[2], "just beyond"), (BEYOND, "beyond")] {
+                let past = scene(centre - inward * past * length);
+                beyond(&format!("{what}, {how}"), &past, 0.0, &guess);
+            }
         }
     }
 
@@ -165,7 +172,8 @@ proptest! {
     ) {
         prop_assume!(d + a > b + c + 0.3);
         let s = 10f64.powf(exponent);
-        let scene = FourBar { a: a * s, b: b * s, c: c * s, d: d * s, omega: 1.0, phase: 0.0, ..FourBar::default() };
+        let (a, b, c, d) = (a * s, b * s, c * s, d * s);
+        let scene = FourBar { a, b, c, d, omega: 1.0, phase: 0.0, ..FourBar::default() };
         let length = scene.d + scene.a;
         let limit = ((a * a + d * d - (b + c) * (b + c)) / (2.0 * a * d)).acos();
         for sign in [1.0, -1.0] {
@@ -191,7 +199,8 @@ proptest! {
         exponent in -2.0_f64..3.0,
     ) {
         let s = 10f64.powf(exponent);
-        let scene = OffsetSlider { r: r * s, l: l * s, e: e * s, omega: 1.0, phase: 0.0, ..OffsetSlider::default() };
+        let (r, l, e) = (r * s, l * s, e * s);
+        let scene = OffsetSlider { r, l, e, omega: 1.0, phase: 0.0, ..OffsetSlider::default() };
         let length = scene.r + scene.l;
         let limit = ((e + l) / r).asin();
         for side in [1.0, -1.0] {
@@ -287,7 +296,11 @@ fn times(toggle: f64, typical: f64, fractions: &[f64], land: bool) -> Vec<f64> {
 
 proptest! {
     // Failures are not persisted: proptest finds no crate root beside a submodule's file.
-    #![proptest_config(ProptestConfig { cases: 16, failure_persistence: None, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig {
+        cases: 16,
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
 
     /// The slider pushed through its outer dead centre.
     #[test]
