@@ -2,7 +2,8 @@
 //! Newton path (`SolverOptions::closed_forms: false`): each group kind over random geometry,
 //! drives, times and guesses on both assembly branches; near, at and beyond toggles (the same
 //! answers and the same errors as the Newton path); a class III group that stays a Newton block
-//! beside a closed-form dyad; and whole runs of `Simulation`, closed forms on and off.
+//! beside a closed-form dyad; whole runs of `Simulation`, closed forms on and off; and the
+//! interpreter's closed-form starts against the generated code's.
 
 #[path = "closed_forms/compare.rs"]
 mod compare;
@@ -21,7 +22,9 @@ use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{Accelerations, Mechanism, Structured, Vector};
 use proptest::prelude::*;
 
-use compare::{Solved, assert_within, between, from_exact, guess_near, run, solve};
+use compare::{
+    Solved, assert_within, between, from_exact, guess_near, run, run_interpreted, solve,
+};
 use exact::Exact;
 use scenes::{
     COLLAR, Collar, FOUR_BAR, FourBar, OFFSET_SLIDER, OffsetSlider, PISTON_CRANK, PUSHED_SLIDER,
@@ -455,4 +458,48 @@ fn simulations_agree_with_closed_forms_on_and_off_on_both_branches() {
             "six-bar: Φ = {phi:e} scene lengths at t = {t}"
         );
     });
+}
+
+/// A run of the generated scene and of the interpreter running its text, closed forms on: the
+/// same closed-form starts and the same states.
+fn interpreted_agrees<M, const N: usize>(
+    what: &str,
+    scene: &M,
+    text: &str,
+    length: f64,
+    period: f64,
+) where
+    M: Structured<Dim = Const<N>> + Accelerations + Clone,
+{
+    let generated = run(scene, true, period, 60);
+    let interpreted = run_interpreted::<N>(text, true, period, 60);
+    for (k, (g, i)) in generated.iter().zip(&interpreted).enumerate() {
+        assert_eq!(g.closed_forms, i.closed_forms, "{what}, step {k}");
+        assert_within(
+            &format!("{what}, step {k}"),
+            between(scene, length, i, g),
+            ROUND_OFF,
+        );
+    }
+}
+
+/// The interpreter follows the same plan, closed forms included, over a turn of each scene.
+#[test]
+fn the_interpreter_starts_from_the_same_closed_forms() {
+    let four_bar = FourBar::default();
+    interpreted_agrees("four-bar", &four_bar, FOUR_BAR, 120.0, TAU / four_bar.omega);
+    let slider = OffsetSlider::default();
+    interpreted_agrees(
+        "offset slider",
+        &slider,
+        OFFSET_SLIDER,
+        80.0,
+        TAU / slider.omega,
+    );
+    let seed = PistonCrank::default();
+    interpreted_agrees("piston-crank", &seed, PISTON_CRANK, 102.6, TAU / seed.omega);
+    let collar = Collar::default();
+    interpreted_agrees("collar", &collar, COLLAR, 4.0, TAU / collar.omega);
+    let six_bar = SixBar::default();
+    interpreted_agrees("six-bar", &six_bar, SIX_BAR, 10.0, TAU / six_bar.omega);
 }

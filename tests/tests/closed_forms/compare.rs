@@ -4,10 +4,10 @@
 use core::f64::consts::TAU;
 use core::mem::discriminant;
 
-use mechgen_runtime::nalgebra::Const;
+use mechgen_runtime::nalgebra::{Const, DefaultAllocator};
 use mechgen_runtime::{
-    Accelerations, Mechanism, Simulation, SolveError, Solver, SolverOptions, State, Structured,
-    Unit, Vector,
+    Accelerations, Mechanism, Simulation, SolveError, Solver, SolverOptions, State, Storage,
+    Structured, Unit, Vector,
 };
 
 use super::exact::Exact;
@@ -190,7 +190,35 @@ pub fn run<M, const N: usize>(
 where
     M: Structured<Dim = Const<N>> + Accelerations + Clone,
 {
-    let solver = Solver::with_options(scene.clone(), options(closed_forms));
+    record(
+        Solver::with_options(scene.clone(), options(closed_forms)),
+        t_end,
+        steps,
+    )
+}
+
+/// [`run`] for the interpreter running a scene's `.mech` text (its default parameters).
+pub fn run_interpreted<const N: usize>(
+    text: &str,
+    closed_forms: bool,
+    t_end: f64,
+    steps: usize,
+) -> Vec<Solved<N>> {
+    let scene = mechgen::compile(mechgen::Input::Text(text), &mechgen::Options::default())
+        .unwrap_or_else(|e| panic!("{e}"));
+    let interpreted = mechgen_interp::Interpreted::new(&scene);
+    record(
+        Solver::with_options(interpreted, options(closed_forms)),
+        t_end,
+        steps,
+    )
+}
+
+fn record<M, const N: usize>(solver: Solver<M>, t_end: f64, steps: usize) -> Vec<Solved<N>>
+where
+    M: Structured + Accelerations,
+    DefaultAllocator: Storage<M::Dim>,
+{
     let mut simulation = Simulation::new(solver, 0.0).expect("assembles at t = 0");
     let mut states = Vec::with_capacity(steps + 1);
     simulation
