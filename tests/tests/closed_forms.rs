@@ -23,7 +23,8 @@ use mechgen_runtime::{Accelerations, Mechanism, Structured, Vector};
 use proptest::prelude::*;
 
 use compare::{
-    Solved, assert_within, between, from_exact, guess_near, run, run_interpreted, solve,
+    Solved, assert_same_turns, assert_within, between, from_exact, guess_near, run,
+    run_interpreted, solve,
 };
 use exact::Exact;
 use scenes::{
@@ -35,7 +36,8 @@ use scenes::{
 /// magnitude.
 const ROUND_OFF: [f64; 3] = [1e-12; 3];
 
-/// How far (in radians and scene lengths) a guess lies from the solution it should lead to.
+/// How far (in radians and scene lengths) a guess lies from the solution it should lead to,
+/// besides whole turns of its angles.
 const SPREAD: f64 = 0.1;
 
 /// Solves one instant of a scene with one block from `guess`, with closed forms on and off: both
@@ -70,6 +72,7 @@ fn check_instant<M, const N: usize>(
         between(scene, length, &closed, &newton),
         ROUND_OFF,
     );
+    assert_same_turns(&what, scene, &closed.q, &newton.q);
 }
 
 /// The closed-form kind of each block of a scene's plan, in solve order (`None`: a Newton
@@ -154,6 +157,7 @@ proptest! {
         phase in -PI..PI,
         times in prop::collection::vec(0.0_f64..1.0, 3),
         moves in prop::collection::vec(-1.0_f64..1.0, 12),
+        turns in -50_i32..50,
     ) {
         prop_assume!(crank_rocker(a, b, c, d));
         let s = size(exponent);
@@ -165,7 +169,7 @@ proptest! {
             for &fraction in &times {
                 let t = fraction * TAU / omega;
                 let want = exact::at(&motion, t);
-                let guess = guess_near(&scene, length, &want.q, &moves, SPREAD);
+                let guess = guess_near(&scene, length, &want.q, (&moves, SPREAD), turns);
                 let what = format!("four-bar {scene:?}, branch {sign}");
                 check_instant(&what, &scene, length, t, &guess, &want);
             }
@@ -182,6 +186,7 @@ proptest! {
         phase in -PI..PI,
         times in prop::collection::vec(0.0_f64..1.0, 3),
         moves in prop::collection::vec(-1.0_f64..1.0, 12),
+        turns in -50_i32..50,
     ) {
         prop_assume!(e.abs() + r < 0.8 * l);
         let s = size(exponent);
@@ -193,7 +198,7 @@ proptest! {
             for &fraction in &times {
                 let t = fraction * TAU / omega;
                 let want = exact::at(&motion, t);
-                let guess = guess_near(&scene, length, &want.q, &moves, SPREAD);
+                let guess = guess_near(&scene, length, &want.q, (&moves, SPREAD), turns);
                 let what = format!("offset slider {scene:?}, side {side}");
                 check_instant(&what, &scene, length, t, &guess, &want);
             }
@@ -212,6 +217,7 @@ proptest! {
         phase in -PI..PI,
         times in prop::collection::vec(0.0_f64..1.0, 3),
         moves in prop::collection::vec(-1.0_f64..1.0, 15),
+        turns in -50_i32..50,
     ) {
         let s = size(exponent);
         let scene = PistonCrank {
@@ -230,7 +236,7 @@ proptest! {
             for &fraction in &times {
                 let t = fraction * TAU / omega;
                 let want = exact::at(&motion, t);
-                let guess = guess_near(&scene, length, &want.q, &moves, SPREAD);
+                let guess = guess_near(&scene, length, &want.q, (&moves, SPREAD), turns);
                 let what = format!("piston-crank {scene:?}, side {side}");
                 check_instant(&what, &scene, length, t, &guess, &want);
             }
@@ -248,6 +254,7 @@ proptest! {
         exponent in -2.0_f64..3.0,
         times in prop::collection::vec(0.0_f64..1.0, 3),
         moves in prop::collection::vec(-1.0_f64..1.0, 9),
+        turns in -50_i32..50,
     ) {
         let s = size(exponent);
         let (reach, stroke) = (reach * s, stroke * s);
@@ -257,7 +264,7 @@ proptest! {
         for &fraction in &times {
             let t = fraction * TAU / omega;
             let want = exact::at(&motion, t);
-            let guess = guess_near(&scene, length, &want.q, &moves, SPREAD);
+            let guess = guess_near(&scene, length, &want.q, (&moves, SPREAD), turns);
             check_instant(&format!("collar {scene:?}"), &scene, length, t, &guess, &want);
         }
     }
@@ -270,6 +277,7 @@ proptest! {
         speed in -1.0_f64..1.0,
         exponent in -2.0_f64..3.0,
         moves in prop::collection::vec(-1.0_f64..1.0, 12),
+        turns in -50_i32..50,
     ) {
         let s = size(exponent);
         // Between the dead centres l − r and l + r, clear of both.
@@ -279,7 +287,7 @@ proptest! {
         let length = scene.l + scene.r;
         for sign in [1.0, -1.0] {
             let want = exact::at(exact::pushed_slider(&scene, sign), 0.0);
-            let guess = guess_near(&scene, length, &want.q, &moves, SPREAD / 3.0);
+            let guess = guess_near(&scene, length, &want.q, (&moves, SPREAD / 3.0), turns);
             let what = format!("pushed slider {scene:?}, branch {sign}");
             check_instant(&what, &scene, length, 0.0, &guess, &want);
         }

@@ -159,25 +159,41 @@ pub fn assert_within(what: &str, worst: [f64; 3], tolerance: [f64; 3]) {
     );
 }
 
-/// The exact motion's positions, every angle but the driven ones moved by up to `spread`
-/// radians and every length by up to `spread` scene lengths (the fractions in `moves`, in
-/// [−1, 1], cycled): a guess near one branch.
+/// The exact motion's positions, every length moved by up to `spread` scene lengths and every
+/// angle by up to `spread` radians (the fractions in `moves`, in [−1, 1], cycled) and by
+/// `turns` whole turns: a guess near one branch. (The solve recomputes explicit coordinates.)
 pub fn guess_near<M: Mechanism<Dim = Const<N>>, const N: usize>(
     scene: &M,
     length: f64,
     exact: &[f64; N],
-    moves: &[f64],
-    spread: f64,
+    (moves, spread): (&[f64], f64),
+    turns: i32,
 ) -> [f64; N] {
     let mut guess = *exact;
     for (k, (g, m)) in guess.iter_mut().zip(moves.iter().cycle()).enumerate() {
-        let unit = match scene.coordinate_unit(k) {
-            Unit::Angle => 1.0,
-            _ => length,
+        *g += match scene.coordinate_unit(k) {
+            Unit::Angle => m * spread + TAU * f64::from(turns),
+            _ => m * spread * length,
         };
-        *g += m * spread * unit;
     }
     guess
+}
+
+/// Every angle of `got` in the same turn as `want`'s, to round-off.
+pub fn assert_same_turns<M: Mechanism<Dim = Const<N>>, const N: usize>(
+    what: &str,
+    scene: &M,
+    got: &[f64; N],
+    want: &[f64; N],
+) {
+    for k in (0..N).filter(|&k| scene.coordinate_unit(k) == Unit::Angle) {
+        assert!(
+            (got[k] - want[k]).abs() <= 1e-12 * want[k].abs().max(1.0),
+            "{what}: angle {k} is {}, not {}",
+            got[k],
+            want[k]
+        );
+    }
 }
 
 /// Every state of a run of `steps` equal steps over `[0, t_end]` from the assembly at t = 0.

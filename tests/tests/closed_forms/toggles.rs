@@ -240,8 +240,10 @@ fn an_offset_slider_exactly_at_its_touching_point_fails_as_newton_does() {
 }
 
 /// Steps a `Simulation` of `scene` through `times`, closed forms on and off, towards a toggle
-/// at `toggle` it cannot pass: both stop with the same error, at the same time (within a step
-/// of the toggle), after the same states.
+/// at `toggle` it cannot pass: both stop in the same step with the same error, located within
+/// a step of the toggle, after the same states. (Where the crossing's bisection meets a
+/// `Singular` solve it reports that midpoint: the two paths, whose midpoint solves differ in
+/// the last bits, may report different midpoints of the same step.)
 fn stops_alike<M, const N: usize>(what: &str, scene: &M, length: f64, toggle: f64, times: &[f64])
 where
     M: Structured<Dim = Const<N>> + Accelerations + Clone,
@@ -267,7 +269,7 @@ where
         .map(|w| w[1] - w[0])
         .fold(times[0], f64::max);
     assert!(
-        (a - b).abs() <= 1e-6 * toggle && (a - toggle).abs() <= longest,
+        (a - toggle).abs() <= longest && (b - toggle).abs() <= longest,
         "{what}: closed forms stop at {a}, Newton at {b}, the toggle is at {toggle}"
     );
     assert_eq!(closed.len(), newton.len(), "{what}");
