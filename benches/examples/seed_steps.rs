@@ -3,12 +3,13 @@
 //! on), as `benches/kinematics.rs` times it: the program to profile a kinematic step with (run
 //! it at two step counts under callgrind and take the difference, so that assembly cancels out).
 //!
-//! `cargo run --release -p mechgen-benches --example seed_steps -- 36000`
+//! `cargo run --release -p mechgen-benches --example seed_steps -- 36000 [newton]` (`newton`:
+//! with the closed-form groups off, Newton's path alone).
 
 use std::hint::black_box;
 
 use mechgen_examples::scenes::PistonCrank;
-use mechgen_runtime::{Simulation, Solver};
+use mechgen_runtime::{Simulation, Solver, SolverOptions};
 
 fn main() {
     let steps: u32 = match std::env::args().nth(1).map(|a| a.parse()) {
@@ -19,9 +20,13 @@ fn main() {
             std::process::exit(2);
         }
     };
+    let options = SolverOptions {
+        closed_forms: std::env::args().nth(2).as_deref() != Some("newton"),
+        ..SolverOptions::default()
+    };
     let seed = PistonCrank::default();
     let h = std::f64::consts::TAU / seed.omega / 360.0;
-    let mut simulation = match Simulation::new(Solver::new(seed), 0.0) {
+    let mut simulation = match Simulation::new(Solver::with_options(seed, options), 0.0) {
         Ok(simulation) => simulation,
         Err(e) => {
             eprintln!("the seed does not assemble: {e}");
