@@ -8,12 +8,13 @@ pub mod fuzzing;
 pub mod reference;
 
 /// A scene both as generated code (`mechanism! { … }`) and as `.mech` text for the interpreter
-/// (`const $text: &str`), from one source: `twin! { TEXT, mechanism Name { … } }`.
+/// (`const $text: &str`), from one source: `twin! { TEXT, mechanism Name { … } }`
+/// (`twin! { pub TEXT, pub mechanism Name { … } }` for a module's scenes).
 #[macro_export]
 macro_rules! twin {
-    ($text:ident, $($scene:tt)*) => {
+    ($vis:vis $text:ident, $($scene:tt)*) => {
         ::mechgen_runtime::mechanism! { $($scene)* }
-        const $text: &str = stringify!($($scene)*);
+        $vis const $text: &str = stringify!($($scene)*);
     };
 }
 
