@@ -63,10 +63,12 @@ impl Rounding {
     #[inline]
     fn solved(&mut self, value: f64, scale: impl FnOnce() -> f64) {
         let value = value.abs();
-        if !(value <= self.threshold) {
-            self.finite &= value <= f64::MAX;
-            self.exceeded |= value * scale() > self.bound;
+        // False for NaN too.
+        if value <= self.threshold {
+            return;
         }
+        self.finite &= value <= f64::MAX;
+        self.exceeded |= value * scale() > self.bound;
     }
 
     /// A block's coordinates, with their scales `inverse_cols` (its own acceptance is

@@ -193,9 +193,13 @@ impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: us
 {
     fn parts(&mut self) -> Parts<'_> {
         let [lu, dense] = &mut self.matrices;
+        // Spelled out rather than `each_mut().map(..)`: the compiler does not always inline
+        // an array map, and this runs on every solve.
+        let [v0, v1, v2, v3, v4, v5, v6, v7, v8, v9] = &mut self.vectors;
+        let [i0, i1, i2] = &mut self.indices;
         Parts::new(
-            self.vectors.each_mut().map(|v| &mut v[..]),
-            self.indices.each_mut().map(|v| &mut v[..]),
+            [v0, v1, v2, v3, v4, v5, v6, v7, v8, v9],
+            [i0, i1, i2],
             &mut self.values,
             [lu.as_flattened_mut(), dense.as_flattened_mut()],
             (
