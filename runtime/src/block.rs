@@ -304,11 +304,14 @@ where
     pub fn orientation(&self, factors: Factors, storage: &FactorStorage<'_>) -> f64 {
         let n = self.n();
         match factors {
-            Factors::Static { .. } => self
-                .block
-                .pivots
-                .iter()
-                .fold(1.0, |sign, &slot| sign * storage.values[slot].signum()),
+            Factors::Static { .. } => {
+                // The parity of the pivots' sign bits: static pivots passed their magnitude
+                // test, so none is zero or NaN.
+                let values = &*storage.values;
+                let negative = (self.block.pivots.iter())
+                    .fold(false, |odd, &slot| odd ^ values[slot].is_sign_negative());
+                if negative { -1.0 } else { 1.0 }
+            }
             Factors::Dense { .. } => {
                 lu::determinant_sign(&storage.lu[..n * n], &storage.swaps[..n])
             }
