@@ -5,7 +5,7 @@ use nalgebra::DefaultAllocator;
 
 use super::api::Solver;
 
-use crate::mechanism::{LengthScale, Storage, Vector};
+use crate::mechanism::{LengthScale, Storage, Unit, Vector};
 use crate::structure::{Stage, Structured};
 
 impl<M: Structured> Solver<M>
@@ -74,11 +74,15 @@ where
     /// The scene's length scale from the current parameters, rounded to a power of two so that
     /// scaling adds no rounding error (1 with unit scaling off).
     pub(super) fn update_scale(&mut self) {
-        self.length = LengthScale::new(if self.options.scale_units {
+        let length = if self.options.scale_units {
             power_of_two(self.mechanism.length_scale())
         } else {
             1.0
-        });
+        };
+        // The same as the last solve's but after a change of parameters or options.
+        if length != self.length.of(Unit::Length) {
+            self.length = LengthScale::new(length);
+        }
     }
 }
 
