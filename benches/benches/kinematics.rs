@@ -210,8 +210,9 @@ where
 
 /// The positions `Simulation` starts Newton from at each of [`STEPS`] steps of `h` from
 /// `checkpoint`: its third-order Taylor prediction (`q + q̇ h + ½ q̈ h² + ⅙ q⃛ h³`, the jerk
-/// from the last two accelerations, none at the first step), asserted to lead `solve_into` to
-/// `Simulation`'s own solutions exactly.
+/// from the last two accelerations, none at the first step; of every coordinate, where
+/// `Simulation` predicts the blocks' only, which are all Newton reads), asserted to lead
+/// `solve_into` to `Simulation`'s own solutions exactly.
 fn predictions<M>(checkpoint: &Simulation<M>, h: f64) -> Vec<Vector<M::Dim>>
 where
     M: Structured + Accelerations + Clone,

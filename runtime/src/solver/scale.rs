@@ -29,27 +29,26 @@ where
         solved: &Vector<M::Dim>,
     ) -> (f64, f64) {
         let m = &self.mechanism;
-        let coordinates = (0..m.stage_count())
-            .filter_map(|s| match m.stage(s) {
-                Some(Stage::Block(block)) => Some(block.coordinates),
-                _ => None,
-            })
-            .flatten()
-            .copied();
         let (previous, prediction, solved) = (
             previous.as_slice(),
             prediction.as_slice(),
             solved.as_slice(),
         );
         let (mut motion, mut correction) = (0.0, 0.0);
-        for j in coordinates {
-            let (Some(x), Some(p), Some(s)) = (prediction.get(j), previous.get(j), solved.get(j))
-            else {
+        for s in 0..m.stage_count() {
+            let Some(Stage::Block(block)) = m.stage(s) else {
                 continue;
             };
-            let power = self.length.inverse_of(m.coordinate_unit(j));
-            motion = larger(motion, ((x - p) * power).abs());
-            correction = larger(correction, ((x - s) * power).abs());
+            for &j in block.coordinates {
+                let (Some(x), Some(p), Some(s)) =
+                    (prediction.get(j), previous.get(j), solved.get(j))
+                else {
+                    continue;
+                };
+                let power = self.length.inverse_of(m.coordinate_unit(j));
+                motion = larger(motion, ((x - p) * power).abs());
+                correction = larger(correction, ((x - s) * power).abs());
+            }
         }
         (motion, correction)
     }
