@@ -16,6 +16,10 @@
 //! `naive` (the seed emitted without folding, simplification or sharing); `interpreted`
 //! (`mechgen-interp` on the scene's `.mech` twin). Besides `step`, each solver method times Φ,
 //! Φ_q and Φ+Φ_q at an assembled state, which the report prints beside its own figures.
+//! For the seed and the four-bar, `generated_solver` and `generated_predicted` time the same
+//! steps through `Solver::solve_into` alone, from the last positions and from the positions
+//! `Simulation` predicts: the difference between `generated` and `generated_predicted` is
+//! `Simulation`'s bookkeeping (predictor, jump and crossing checks, state rotation).
 //!
 //! The group `seed/safeguards` times a seed step with the stability safeguards (unit scaling,
 //! condition estimate) on and off. The groups `seed_forces/*` time the seed with its mass
@@ -49,7 +53,8 @@ use mechgen_examples::{closed_form, written_out};
 use mechgen_interp::Interpreted;
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{
-    Dense, Matrix, Mechanism, Simulation, Solver, SolverOptions, State, Storage, Structured, Vector,
+    Accelerations, Dense, Matrix, Mechanism, Simulation, Solver, SolverOptions, State, Storage,
+    Structured, Vector,
 };
 
 /// The seed generated naively (no folding, no simplification, no shared sub-expressions) by
@@ -202,6 +207,72 @@ where
     group.finish();
 }
 
+/// The same steps through `Solver::solve_into`, each started from the positions `Simulation`
+/// predicts for it (computed before timing, and checked to give its solutions to the bit):
+/// the same Newton work, without the predictor, the jump and crossing checks and the state
+/// rotation, so the difference from `Simulation`'s step is that bookkeeping.
+fn predicted_steps<M>(c: &mut Criterion, fastest: &Fastest, label: &str, mechanism: M, period: f64)
+where
+    M: Structured + Accelerations + Clone,
+    M::Workspace: Clone,
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let options = Plan::full().reference.options();
+    let checkpoint =
+        Simulation::new(Solver::with_options(mechanism, options), 0.0).expect("scene assembles");
+    let h = period / STEPS as f64;
+    let guesses = predictions(&checkpoint, h);
+    let mut group = c.benchmark_group(label);
+    let start = (checkpoint.solver().clone(), checkpoint.state().clone());
+    time_steps(&mut group, fastest, label, &start, |(solver, state), k| {
+        state.q.copy_from(&guesses[k as usize - 1]);
+        solver.solve_into(k as f64 * h, state).expect("solves");
+        black_box(state.q[0]);
+    });
+    group.finish();
+}
+
+/// The positions `Simulation` starts Newton from at each of [`STEPS`] steps of `h` from
+/// `checkpoint`: its third-order Taylor prediction (`q + q̇ h + ½ q̈ h² + ⅙ q⃛ h³`, the jerk
+/// from the last two accelerations, none at the first step; of every coordinate, where
+/// `Simulation` predicts the blocks' only, which are all Newton reads), asserted to lead
+/// `solve_into` to `Simulation`'s own solutions exactly.
+fn predictions<M>(checkpoint: &Simulation<M>, h: f64) -> Vec<Vector<M::Dim>>
+where
+    M: Structured + Accelerations + Clone,
+    M::Workspace: Clone,
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let mut simulation = checkpoint.clone();
+    let mut solver = checkpoint.solver().clone();
+    let mut previous: Option<State<M>> = None;
+    let mut guesses = Vec::new();
+    for k in 1..=STEPS {
+        let t = k as f64 * h;
+        let current = simulation.state().clone();
+        let step = t - current.t;
+        let mut guess = current.q.clone();
+        for j in 0..guess.len() {
+            let jerk = previous.as_ref().map_or(0.0, |p| {
+                step * step * step / (6.0 * (current.t - p.t)) * (current.qdd()[j] - p.qdd()[j])
+            });
+            guess[j] =
+                current.q[j] + step * current.qd()[j] + 0.5 * step * step * current.qdd()[j] + jerk;
+        }
+        let mut check = current.clone();
+        check.q.copy_from(&guess);
+        solver.solve_into(t, &mut check).expect("solves");
+        let solved = simulation.step_to(t).expect("steps");
+        assert_eq!(
+            check.q, solved.q,
+            "the prediction at step {k} is Simulation's"
+        );
+        guesses.push(guess);
+        previous = Some(current);
+    }
+    guesses
+}
+
 /// Steps of a revolution of `period` from `checkpoint`.
 fn simulation_steps<M>(
     group: &mut BenchmarkGroup<'_, WallTime>,
@@ -349,6 +420,7 @@ fn seed(c: &mut Criterion, fastest: &Fastest) {
     driven(c, fastest, "seed/generated", seed, period);
     closed_forms(c, fastest, "seed", seed, period);
     solver_steps(c, fastest, "seed/generated_solver", seed, period);
+    predicted_steps(c, fastest, "seed/generated_predicted", seed, period);
     driven(c, fastest, "seed/dense", Dense::new(seed), period);
     driven(
         c,
@@ -438,6 +510,7 @@ fn four_bar(c: &mut Criterion, fastest: &Fastest) {
     driven(c, fastest, "four_bar/generated", four_bar, period);
     closed_forms(c, fastest, "four_bar", four_bar, period);
     solver_steps(c, fastest, "four_bar/generated_solver", four_bar, period);
+    predicted_steps(c, fastest, "four_bar/generated_predicted", four_bar, period);
     driven(c, fastest, "four_bar/dense", Dense::new(four_bar), period);
     let forward = Dense::new(ForwardDifference::new(four_bar));
     driven(c, fastest, "four_bar/forward_difference", forward, period);
@@ -591,6 +664,14 @@ fn summary(fastest: &Fastest) {
                 "  {scene}: Simulation step {:.1} ns; Solver::solve_into from the last positions \
                  {:.1} ns ({:+.1} ns: what the predictor saves, less the bookkeeping)",
                 step * 1e9,
+                solver * 1e9,
+                (step - solver) * 1e9
+            );
+        }
+        if let (Some(step), Some(solver)) = (time("generated"), time("generated_predicted")) {
+            println!(
+                "  {scene}: Solver::solve_into from Simulation's predictions {:.1} ns \
+                 ({:+.1} ns: Simulation's bookkeeping, the predictor and the jump and crossing checks)",
                 solver * 1e9,
                 (step - solver) * 1e9
             );

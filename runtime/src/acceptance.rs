@@ -12,6 +12,8 @@
 //! evaluated: the hot path pays one comparison per coordinate. Above it (a weld on an arm
 //! driven to 1e12 rad, whose 30° is rounded to 4e-5 rad), Φ is evaluated once at the end of
 //! the sweep and every explicit equation is held to the acceptance tolerance.
+//!
+//! The same look at each solved coordinate tells the sweep whether all of them are finite.
 
 use nalgebra::DefaultAllocator;
 
@@ -24,24 +26,49 @@ use crate::structure::{Stage, Structured};
 pub(crate) const COEFFICIENT_ROOM: f64 = 1024.0;
 
 /// What a sweep has solved, for deciding whether its explicit stages need their residuals
-/// evaluated.
+/// evaluated, and whether every coordinate it solved is finite.
+///
+/// Both need a look at each solved coordinate; the unit lookup that scales it is skipped for
+/// the usual one, whose unscaled size is within `bound` over the largest unit scale (no unit
+/// can then scale it past `bound`). A non-finite value fails that comparison too, so both
+/// tests cost one comparison per coordinate on the hot path.
 pub(crate) struct Rounding {
     /// Largest scaled coordinate below which no explicit residual can reach the tolerance.
     bound: f64,
-    /// Largest scaled |q_j| solved so far.
-    magnitude: f64,
-    /// Whether an explicit stage was assigned with `magnitude` above `bound`.
+    /// `bound` over the largest unit scale.
+    threshold: f64,
+    /// Whether a coordinate solved so far is above `bound` (scaled).
+    exceeded: bool,
+    /// Whether an explicit stage was assigned after a coordinate above `bound` was solved.
     pending: bool,
+    /// Whether every coordinate solved so far is finite.
+    finite: bool,
 }
 
 impl Rounding {
-    /// A sweep accepting scaled residuals up to `acceptance`.
-    pub(crate) fn new(acceptance: f64) -> Self {
+    /// A sweep accepting scaled residuals up to `acceptance`, with the scene's `length`.
+    pub(crate) fn new(acceptance: f64, length: &LengthScale) -> Self {
+        let bound = acceptance / (f64::EPSILON * COEFFICIENT_ROOM);
         Self {
-            bound: acceptance / (f64::EPSILON * COEFFICIENT_ROOM),
-            magnitude: 0.0,
+            bound,
+            threshold: bound / length.largest_inverse(),
+            exceeded: false,
             pending: false,
+            finite: true,
         }
+    }
+
+    /// Records the solved `value` of a coordinate whose scale (L⁻ᵖ) `scale` gives, looked up
+    /// only when the value is beyond the threshold or not finite.
+    #[inline]
+    fn solved(&mut self, value: f64, scale: impl FnOnce() -> f64) {
+        let value = value.abs();
+        // False for NaN too.
+        if value <= self.threshold {
+            return;
+        }
+        self.finite &= value <= f64::MAX;
+        self.exceeded |= value * scale() > self.bound;
     }
 
     /// A block's coordinates, with their scales `inverse_cols` (its own acceptance is
@@ -57,7 +84,7 @@ impl Rounding {
     {
         let q = q.as_slice();
         for (&j, &c) in coordinates.iter().zip(inverse_cols) {
-            self.magnitude = larger(self.magnitude, (q[j] * c).abs());
+            self.solved(q[j], || c);
         }
     }
 
@@ -73,16 +100,19 @@ impl Rounding {
     {
         let q = q.as_slice();
         for &j in coordinates {
-            let scaled = q[j] * length.inverse_of(m.coordinate_unit(j));
-            self.magnitude = larger(self.magnitude, scaled.abs());
+            self.solved(q[j], || length.inverse_of(m.coordinate_unit(j)));
         }
-        // NaN compares false: a non-finite assignment is reported by the sweep's own check.
-        self.pending |= self.magnitude > self.bound;
+        self.pending |= self.exceeded;
     }
 
     /// Whether an explicit stage's residuals must be evaluated.
     pub(crate) fn pending(&self) -> bool {
         self.pending
+    }
+
+    /// Whether every coordinate recorded is finite.
+    pub(crate) fn finite(&self) -> bool {
+        self.finite
     }
 }
 

@@ -18,10 +18,10 @@
 use nalgebra::DefaultAllocator;
 
 use crate::lu::{self, LuError};
-use crate::mechanism::{LengthScale, Storage, Vector};
+use crate::mechanism::{LengthScale, Storage, Unit, Vector};
 use crate::options::SolverOptions;
 use crate::structure::{Block, Pattern, Structured};
-use crate::workspace::{Estimator, FactorStorage, Scales};
+use crate::workspace::{Estimator, FactorStorage, Scales, ScalesOf};
 
 /// The scale below which a block's entries count as small: the unit-scaled Jacobian's own.
 pub(crate) const SCALE_FLOOR: f64 = 1.0;
@@ -76,8 +76,14 @@ where
         self.block.len()
     }
 
-    /// Writes D_r (L⁻ᵖ per equation), D_c (Lᵖ per coordinate) and D_c⁻¹ for the block.
+    /// Writes D_r (L⁻ᵖ per equation), D_c (Lᵖ per coordinate) and D_c⁻¹ for the block,
+    /// unless `scales` hold them already (units are the scene's: only the block and the
+    /// length scale can change them).
     pub fn set_scales(&self, scales: &mut Scales<'_>, length: &LengthScale) {
+        let of = ScalesOf(Some((self.stage, length.of(Unit::Length))));
+        if *scales.of == of {
+            return;
+        }
         for (r, &e) in scales.rows.iter_mut().zip(self.block.equations) {
             *r = length.inverse_of(self.m.equation_unit(e));
         }
@@ -86,6 +92,7 @@ where
             let unit = self.m.coordinate_unit(j);
             (*c, *inverse) = (length.of(unit), length.inverse_of(unit));
         }
+        *scales.of = of;
     }
 
     /// Evaluates Φ_b into `phi` and the scaled Jacobian `S` into `values`; returns
@@ -304,11 +311,14 @@ where
     pub fn orientation(&self, factors: Factors, storage: &FactorStorage<'_>) -> f64 {
         let n = self.n();
         match factors {
-            Factors::Static { .. } => self
-                .block
-                .pivots
-                .iter()
-                .fold(1.0, |sign, &slot| sign * storage.values[slot].signum()),
+            Factors::Static { .. } => {
+                // The parity of the pivots' sign bits: static pivots passed their magnitude
+                // test, so none is zero or NaN.
+                let values = &*storage.values;
+                let negative = (self.block.pivots.iter())
+                    .fold(false, |odd, &slot| odd ^ values[slot].is_sign_negative());
+                if negative { -1.0 } else { 1.0 }
+            }
             Factors::Dense { .. } => {
                 lu::determinant_sign(&storage.lu[..n * n], &storage.swaps[..n])
             }

@@ -108,7 +108,8 @@ where
     /// configuration to get there.
     fn solve_from_bracket(&mut self, t: f64) -> Result<(u64, bool), SolveError> {
         let (_, next) = pair(&mut self.states, self.newest);
-        if !predict(&self.bracket, next, false, t) {
+        let m = self.solver.mechanism();
+        if !predict(m, &self.bracket, next, false, t, &mut self.prediction) {
             next.q.copy_from(&self.bracket.q);
         }
         self.has_previous = false;

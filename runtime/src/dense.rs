@@ -15,7 +15,7 @@ use crate::mechanism::{
     Velocities,
 };
 use crate::structure::{Block, Pattern, Stage, Structured};
-use crate::workspace::{Parts, Workspace};
+use crate::workspace::{Parts, ScalesOf, Workspace};
 
 /// A mechanism solved densely, as one block: see the module documentation.
 pub struct Dense<M: Mechanism>
@@ -350,6 +350,7 @@ where
     /// The force solve's multipliers (the one block has no static factors to archive).
     multipliers: Vector<D>,
     archived: [bool; 1],
+    scales_of: ScalesOf,
 }
 
 impl<D: nalgebra::Dim> DenseBuffers<D>
@@ -368,6 +369,7 @@ where
             downstream: [false],
             multipliers: Vector::zeros_generic(dim, U1),
             archived: [false],
+            scales_of: ScalesOf(None),
         }
     }
 }
@@ -387,7 +389,7 @@ where
                 self.undetermined.as_mut_slice(),
                 &mut self.downstream,
             ),
-            &mut [],
+            (&mut [], &mut self.scales_of),
             (self.multipliers.as_mut_slice(), &mut self.archived),
         )
     }

@@ -175,6 +175,11 @@ impl LengthScale {
     pub fn inverse_of(&self, unit: Unit) -> f64 {
         self.inverses[unit as usize]
     }
+
+    /// The largest L⁻ᵖ of any unit: no value grows more when measured in scene units.
+    pub fn largest_inverse(&self) -> f64 {
+        self.inverses.iter().fold(1.0, |m, &x| m.max(x))
+    }
 }
 
 /// The kinematic equations of a planar mechanism in Cartesian body coordinates.

@@ -6,10 +6,10 @@
 use nalgebra::DefaultAllocator;
 
 use crate::error::{Quantity, SolveError};
-use crate::mechanism::{Mechanism, Outputs, Storage, Vector};
+use crate::mechanism::{Outputs, Storage, Vector};
 use crate::solver::Solver;
 use crate::state::State;
-use crate::structure::Structured;
+use crate::structure::{Stage, Structured};
 
 /// A predicted step is suspect when Newton moved the solution further from the prediction than
 /// this fraction of the predicted motion (both measured on the Newton blocks' coordinates, the
@@ -78,7 +78,7 @@ where
     /// The latest solution before a singular crossing, while the crossing is located.
     pub(crate) bracket: State<M>,
     /// The last prediction, to measure how far Newton moved from it.
-    prediction: Vector<M::Dim>,
+    pub(crate) prediction: Vector<M::Dim>,
     /// Whether `next` holds a solved earlier state (for the positions-only predictor).
     pub(crate) has_previous: bool,
     predictor: bool,
@@ -176,8 +176,10 @@ where
     /// expansion `q + q̇ h + ½ q̈ h² + ⅙ q⃛ h³` (`h = t − t_last`) with the derivatives the scene
     /// computes and one more from the difference with the previous state (the jerk from the
     /// last two accelerations), or, for a positions-only scene, the secant through the last two
-    /// solved positions. The third-order guess is O(h⁴) off, so Newton typically needs two
-    /// updates, the second of round-off size (whose factors then serve the rates).
+    /// solved positions; of the Newton blocks' coordinates only, the ones Newton starts from
+    /// (explicit stages assign theirs whatever the guess). The third-order guess is O(h⁴) off,
+    /// so Newton typically needs two updates, the second of round-off size (whose factors then
+    /// serve the rates).
     ///
     /// When that solve fails in a way a shorter step may cure (no convergence, no assembly, a
     /// branch flip, a singular solution), predicts a motion of more than a scene length or a
@@ -302,12 +304,16 @@ where
 
     /// One predicted solve at `t` into `next`; on success `next` becomes `current`, except for
     /// a suspected jump, which is left unaccepted unless `accept_jump`.
+    // Inlined: the usual step is one `advance`, and its large `Outcome` is then not moved
+    // through memory (30 instructions of a seed step's ~4,500).
+    #[inline]
     fn advance(&mut self, t: f64, accept_jump: bool) -> Outcome {
         let (current, next) = pair(&mut self.states, self.newest);
-        let predicted = self.predictor && predict(current, next, self.has_previous, t);
-        if predicted {
-            self.prediction.copy_from(&next.q);
-        } else {
+        let m = self.solver.mechanism();
+        let history = self.has_previous;
+        let predicted =
+            self.predictor && predict(m, current, next, history, t, &mut self.prediction);
+        if !predicted {
             next.q.copy_from(&current.q);
         }
         // From here `next` no longer holds the previous state, whatever the outcome.
@@ -374,79 +380,101 @@ pub(crate) fn pair<T>(states: &mut [T; 2], newest: usize) -> (&T, &mut T) {
     if newest == 0 { (a, b) } else { (b, a) }
 }
 
-/// Writes the predicted positions at `t` into `next.q` and says whether it did (otherwise
-/// `next` is untouched): the Taylor expansion from `current` with the derivatives the scene
-/// computes, plus one more from the difference with the previous state, which `next` still
-/// holds when `history` (the secant slope for positions-only scenes, q̈ from two velocities,
-/// the jerk from two accelerations). A positions-only scene without history has nothing to
-/// predict with.
-pub(crate) fn predict<M: Mechanism>(
+/// Writes the guess at `t` into `guess` and `next.q` and says whether it did (otherwise
+/// neither is touched): `current`'s positions, with the Newton blocks' coordinates predicted
+/// by the Taylor expansion from `current` with the derivatives the scene computes, plus one
+/// more from the difference with the previous state, which `next` still holds when `history`
+/// (the secant slope for positions-only scenes, q̈ from two velocities, the jerk from two
+/// accelerations). A positions-only scene without history has nothing to predict with.
+///
+/// Only the blocks' coordinates are predicted: they are the ones a solve starts Newton from,
+/// while every other coordinate belongs to an explicit stage, which assigns it whatever its
+/// guess (and `current`'s value keeps the guess finite, as the solve checks).
+pub(crate) fn predict<M: Structured>(
+    m: &M,
     current: &State<M>,
     next: &mut State<M>,
     history: bool,
     t: f64,
+    guess: &mut Vector<M::Dim>,
 ) -> bool
 where
     DefaultAllocator: Storage<M::Dim>,
 {
-    // Kept whole: one arm per output kind, each one Taylor formula over the coordinates.
     let h = t - current.t;
     let h_prev = current.t - next.t;
     let history = history && h_prev != 0.0 && h_prev.is_finite();
-    let (q, qd, qdd) = (
-        current.q.as_slice(),
-        current.velocities.as_slice(),
-        current.accelerations.as_slice(),
-    );
-    let State {
-        q: guess,
-        velocities: qd_prev,
-        accelerations: qdd_prev,
-        ..
-    } = next;
-    let guess = guess.as_mut_slice();
-    let h2 = 0.5 * h * h;
-    // Coefficients hoisted out of the loops: one division per step, none per coordinate.
-    match current.outputs() {
+    // Coefficients hoisted out of the loop: one division per step, none per coordinate.
+    let formula = match current.outputs() {
         Outputs::Positions if !history => return false,
-        Outputs::Positions => {
-            let ratio = h / h_prev;
-            for (g, &q) in guess.iter_mut().zip(q) {
-                *g = q + (q - *g) * ratio;
-            }
+        Outputs::Positions => Taylor::Secant(h / h_prev),
+        Outputs::Velocities if history => Taylor::Velocities(0.5 * h * h / h_prev),
+        Outputs::Velocities => Taylor::Velocity,
+        Outputs::Accelerations | Outputs::Forces if history => {
+            Taylor::Accelerations(h * h * h / (6.0 * h_prev))
         }
-        Outputs::Velocities if history => {
-            let c = h2 / h_prev;
-            let rates = qd.iter().zip(qd_prev.as_slice());
-            for ((g, &q), (&v, &v_prev)) in guess.iter_mut().zip(q).zip(rates) {
-                *g = q + h * v + c * (v - v_prev);
-            }
-        }
-        Outputs::Velocities => {
-            for ((g, &q), &v) in guess.iter_mut().zip(q).zip(qd) {
-                *g = q + h * v;
-            }
-        }
-        Outputs::Accelerations | Outputs::Forces => {
-            let c = if history {
-                h * h * h / (6.0 * h_prev)
-            } else {
-                0.0
+        Outputs::Accelerations | Outputs::Forces => Taylor::Acceleration,
+    };
+    let now = [&current.q, &current.velocities, &current.accelerations].map(|v| v.as_slice());
+    let before = [&next.q, &next.velocities, &next.accelerations].map(|v| v.as_slice());
+    guess.copy_from(&current.q);
+    let guess_slice = guess.as_mut_slice();
+    for s in 0..m.stage_count() {
+        let Some(Stage::Block(block)) = m.stage(s) else {
+            continue;
+        };
+        for &j in block.coordinates {
+            let (Some(g), Some(value)) = (guess_slice.get_mut(j), formula.at(j, h, now, before))
+            else {
+                continue;
             };
-            let previous = qdd_prev.as_slice();
-            for (k, g) in guess.iter_mut().enumerate() {
-                // Without history the jerk term is left out, not multiplied by zero: `next`
-                // may hold a failed solve's non-finite iterate.
-                let jerk = if history {
-                    c * (qdd[k] - previous[k])
-                } else {
-                    0.0
-                };
-                *g = q[k] + h * qd[k] + h2 * qdd[k] + jerk;
-            }
+            *g = value;
         }
     }
+    next.q.copy_from(guess);
     true
+}
+
+/// The Taylor formula of a prediction, by what the scene computes and whether the previous
+/// state is known, with its coefficient of the difference with that state.
+#[derive(Clone, Copy)]
+enum Taylor {
+    /// Positions only: the secant through the last two, `q + (q − q_prev) h / h_prev`.
+    Secant(f64),
+    /// `q + q̇ h`.
+    Velocity,
+    /// … `+ ½ q̈ h²`, q̈ from the last two velocities (the coefficient `h² / (2 h_prev)`).
+    Velocities(f64),
+    /// `q + q̇ h + ½ q̈ h²`.
+    Acceleration,
+    /// … `+ ⅙ q⃛ h³`, q⃛ from the last two accelerations (the coefficient `h³ / (6 h_prev)`).
+    Accelerations(f64),
+}
+
+impl Taylor {
+    /// The prediction of coordinate `j` over a step `h` from the (q, q̇, q̈) `now`, with the
+    /// previous state's `before`; `None` past the end. A term is left out, not multiplied by
+    /// zero, where the state has no such value (`before` may hold a failed solve's non-finite
+    /// iterate).
+    #[inline]
+    fn at(self, j: usize, h: f64, now: [&[f64]; 3], before: [&[f64]; 3]) -> Option<f64> {
+        let [q, qd, qdd] = now.map(|v| v.get(j).copied());
+        let [q_prev, qd_prev, qdd_prev] = before.map(|v| v.get(j).copied());
+        let q = q?;
+        Some(match self {
+            Taylor::Secant(ratio) => q + (q - q_prev?) * ratio,
+            Taylor::Velocity => q + h * qd?,
+            Taylor::Velocities(c) => {
+                let v = qd?;
+                q + h * v + c * (v - qd_prev?)
+            }
+            Taylor::Acceleration => q + h * qd? + 0.5 * h * h * qdd?,
+            Taylor::Accelerations(c) => {
+                let a = qdd?;
+                q + h * qd? + 0.5 * h * h * a + c * (a - qdd_prev?)
+            }
+        })
+    }
 }
 
 /// The k-th of `steps` equal steps from `t0` to `t_end`: `t0 + k·h` with

@@ -68,7 +68,15 @@ pub(crate) struct Scales<'a> {
     pub rows: &'a mut [f64],
     pub cols: &'a mut [f64],
     pub inverse_cols: &'a mut [f64],
+    /// Whose scales these are: see [`ScalesOf`].
+    pub of: &'a mut ScalesOf,
 }
+
+/// The block (stage index) and the length scale whose unit scales [`Scales`] hold, if any:
+/// `BlockSolve::set_scales`, their only writer, skips rewriting the same ones, so a scene
+/// with one block computes them once per length scale rather than on every solve.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct ScalesOf(pub Option<(usize, f64)>);
 
 /// A block's factors: its Jacobian values and static factors (S), dense partial-pivoting
 /// factors (B²) and their row swaps (B).
@@ -103,7 +111,7 @@ impl<'a> Parts<'a> {
         values: &'a mut [f64],
         [lu, dense]: [&'a mut [f64]; 2],
         (hints, undetermined, downstream): (&'a mut [usize], &'a mut [usize], &'a mut [bool]),
-        trig: &'a mut [f64],
+        (trig, scales_of): (&'a mut [f64], &'a mut ScalesOf),
         (forces, archived): (&'a mut [f64], &'a mut [bool]),
     ) -> Self {
         Parts {
@@ -118,6 +126,7 @@ impl<'a> Parts<'a> {
                 rows,
                 cols,
                 inverse_cols,
+                of: scales_of,
             },
             factors: FactorStorage { values, lu, swaps },
             estimator: Estimator { x, signs },
@@ -156,6 +165,7 @@ pub struct Buffers<
     undetermined: [usize; N],
     downstream: [bool; K],
     trig: [f64; T],
+    scales_of: ScalesOf,
     forces: [f64; R],
     archived: [bool; K],
 }
@@ -174,6 +184,7 @@ impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: us
             undetermined: [0; N],
             downstream: [false; K],
             trig: [0.0; T],
+            scales_of: ScalesOf(None),
             forces: [0.0; R],
             archived: [false; K],
         }
@@ -193,9 +204,13 @@ impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: us
 {
     fn parts(&mut self) -> Parts<'_> {
         let [lu, dense] = &mut self.matrices;
+        // Spelled out rather than `each_mut().map(..)`: the compiler does not always inline
+        // an array map, and this runs on every solve.
+        let [v0, v1, v2, v3, v4, v5, v6, v7, v8, v9] = &mut self.vectors;
+        let [i0, i1, i2] = &mut self.indices;
         Parts::new(
-            self.vectors.each_mut().map(|v| &mut v[..]),
-            self.indices.each_mut().map(|v| &mut v[..]),
+            [v0, v1, v2, v3, v4, v5, v6, v7, v8, v9],
+            [i0, i1, i2],
             &mut self.values,
             [lu.as_flattened_mut(), dense.as_flattened_mut()],
             (
@@ -203,7 +218,7 @@ impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: us
                 &mut self.undetermined,
                 &mut self.downstream,
             ),
-            &mut self.trig,
+            (&mut self.trig, &mut self.scales_of),
             (&mut self.forces, &mut self.archived),
         )
     }
@@ -225,6 +240,7 @@ pub struct VecBuffers {
     undetermined: alloc::vec::Vec<usize>,
     downstream: alloc::vec::Vec<bool>,
     trig: alloc::vec::Vec<f64>,
+    scales_of: ScalesOf,
     forces: alloc::vec::Vec<f64>,
     archived: alloc::vec::Vec<bool>,
 }
@@ -252,6 +268,7 @@ impl VecBuffers {
             undetermined: vec![0; n],
             downstream: vec![false; stages],
             trig: vec![0.0; trig],
+            scales_of: ScalesOf(None),
             forces: vec![0.0; forces],
             archived: vec![false; stages],
         }
@@ -271,7 +288,7 @@ impl Workspace for VecBuffers {
                 &mut self.undetermined,
                 &mut self.downstream,
             ),
-            &mut self.trig,
+            (&mut self.trig, &mut self.scales_of),
             (&mut self.forces, &mut self.archived),
         )
     }

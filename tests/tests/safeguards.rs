@@ -1,7 +1,9 @@
 //! The runtime's safeguards, each held by a test that fails when the safeguard is removed (each
 //! checked by applying the removal by hand): crawl detection, the condition estimate of blocks
-//! larger than 4, the jump test, and the static pivots' check.
+//! larger than 4, the jump test, and the static pivots' check; and unit scaling, whose scales a
+//! solver keeps between solves, follows a change of length scale.
 
+use mechgen_examples::scenes::PistonCrank;
 use mechgen_examples::stability::SliderCrank;
 use mechgen_runtime::nalgebra::{Const, DMatrix};
 use mechgen_runtime::{
@@ -184,4 +186,43 @@ fn a_static_pivot_is_checked_where_an_unchecked_one_gives_wrong_rates() {
         assert!((wrong.qd()[5] - 1.0).abs() > 1e-3, "{k}: {}", wrong.qd()[5]);
         assert_eq!(wrong.fallbacks, 0, "{k}");
     }
+}
+
+/// A solver keeps its blocks' unit scales between solves: switched between scaled and
+/// unscaled units, it solves as a new solver with those options does, to the bit (the seed's
+/// block condition differs with and without scaling, so stale scales would show).
+#[test]
+fn kept_unit_scales_follow_a_change_of_length_scale() {
+    let seed = PistonCrank::default();
+    let scaled = SolverOptions::default();
+    let unscaled = SolverOptions {
+        scale_units: false,
+        ..scaled
+    };
+    let simulation = Simulation::new(Solver::with_options(seed, scaled), 0.0).expect("assembles");
+    let start = simulation.state().clone();
+    let mut reused = simulation.into_solver();
+    let mut conditions = Vec::new();
+    for (k, options) in [unscaled, scaled, unscaled, scaled].into_iter().enumerate() {
+        let t = 1e-3 * (k + 1) as f64;
+        reused.set_options(options);
+        let mut kept = start.clone();
+        reused.solve_into(t, &mut kept).expect("solves");
+        let mut fresh = start.clone();
+        Solver::with_options(seed, options)
+            .solve_into(t, &mut fresh)
+            .expect("solves");
+        assert_eq!(kept.q, fresh.q, "positions at step {k}");
+        assert_eq!(kept.qdd(), fresh.qdd(), "accelerations at step {k}");
+        assert_eq!(
+            kept.condition.to_bits(),
+            fresh.condition.to_bits(),
+            "step {k}"
+        );
+        conditions.push(kept.condition);
+    }
+    assert_ne!(
+        conditions[0], conditions[1],
+        "scaling changes the block's condition"
+    );
 }

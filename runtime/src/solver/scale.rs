@@ -5,7 +5,7 @@ use nalgebra::DefaultAllocator;
 
 use super::api::Solver;
 
-use crate::mechanism::{LengthScale, Storage, Vector};
+use crate::mechanism::{LengthScale, Storage, Unit, Vector};
 use crate::structure::{Stage, Structured};
 
 impl<M: Structured> Solver<M>
@@ -29,27 +29,26 @@ where
         solved: &Vector<M::Dim>,
     ) -> (f64, f64) {
         let m = &self.mechanism;
-        let coordinates = (0..m.stage_count())
-            .filter_map(|s| match m.stage(s) {
-                Some(Stage::Block(block)) => Some(block.coordinates),
-                _ => None,
-            })
-            .flatten()
-            .copied();
         let (previous, prediction, solved) = (
             previous.as_slice(),
             prediction.as_slice(),
             solved.as_slice(),
         );
         let (mut motion, mut correction) = (0.0, 0.0);
-        for j in coordinates {
-            let (Some(x), Some(p), Some(s)) = (prediction.get(j), previous.get(j), solved.get(j))
-            else {
+        for s in 0..m.stage_count() {
+            let Some(Stage::Block(block)) = m.stage(s) else {
                 continue;
             };
-            let power = self.length.inverse_of(m.coordinate_unit(j));
-            motion = larger(motion, ((x - p) * power).abs());
-            correction = larger(correction, ((x - s) * power).abs());
+            for &j in block.coordinates {
+                let (Some(x), Some(p), Some(s)) =
+                    (prediction.get(j), previous.get(j), solved.get(j))
+                else {
+                    continue;
+                };
+                let power = self.length.inverse_of(m.coordinate_unit(j));
+                motion = larger(motion, ((x - p) * power).abs());
+                correction = larger(correction, ((x - s) * power).abs());
+            }
         }
         (motion, correction)
     }
@@ -74,11 +73,15 @@ where
     /// The scene's length scale from the current parameters, rounded to a power of two so that
     /// scaling adds no rounding error (1 with unit scaling off).
     pub(super) fn update_scale(&mut self) {
-        self.length = LengthScale::new(if self.options.scale_units {
+        let length = if self.options.scale_units {
             power_of_two(self.mechanism.length_scale())
         } else {
             1.0
-        });
+        };
+        // The same as the last solve's but after a change of parameters or options.
+        if length != self.length.of(Unit::Length) {
+            self.length = LengthScale::new(length);
+        }
     }
 }
 

@@ -13,7 +13,7 @@ use super::rates::{assign_rates, block_rates, check_rates};
 use crate::acceptance::{self, Rounding};
 use crate::block::BlockSolve;
 use crate::error::{Quantity, SolveError};
-use crate::finite::{check_finite, non_finite};
+use crate::finite::non_finite;
 use crate::forces;
 use crate::mechanism::{Mechanism, Storage, Vector};
 use crate::options::Rates;
@@ -83,7 +83,7 @@ where
         let mut total = Convergence::start(options.estimate_condition);
         // A looser residual tolerance asked for loosens acceptance with it (as in `position`).
         let acceptance = options.acceptance_tolerance.max(options.residual_tolerance);
-        let mut rounding = Rounding::new(acceptance);
+        let mut rounding = Rounding::new(acceptance, length);
         // How much of the force solve's archive the blocks have filled.
         let mut archived = 0;
         for s in 0..m.stage_count() {
@@ -126,10 +126,14 @@ where
                 None => break,
             }
         }
-        // Blocks check what they solve; an explicit assignment's non-finite value shows here
-        // (or earlier, as the non-finite Φ or rate of a block that reads it).
+        // Every coordinate a stage solved went through `rounding`, which saw whether it is
+        // finite (a coordinate no stage solves keeps the guess, checked on entry): an explicit
+        // assignment's non-finite value shows here (or earlier, as the non-finite Φ or rate of
+        // a block that reads it).
         *reached = m.stage_count();
-        check_finite(q, t, Quantity::Phi)?;
+        if !rounding.finite() {
+            return Err(non_finite(t, Quantity::Phi));
+        }
         if rounding.pending() {
             let explicit = acceptance::check_explicit(m, q, t, length, acceptance)?;
             total.residual = total.residual.max(explicit);
