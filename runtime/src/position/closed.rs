@@ -50,23 +50,43 @@ where
     let mut out = [f64::NAN; 2 * MAX_SIZE];
     bs.m.closed_form(bs.stage, q, parts.trig, t, &mut out[..2 * n]);
     let coordinates = bs.block.coordinates;
-    // Per coordinate: the guess, its scale, and each candidate moved to the guess's turn;
-    // then the squared scaled distances from the guess to each candidate and between them.
+    let (mut guess, mut angles) = ([0.0; MAX_SIZE], [false; MAX_SIZE]);
+    for (j, &c) in coordinates.iter().enumerate() {
+        (guess[j], angles[j]) = (q[c], bs.m.coordinate_unit(c) == Unit::Angle);
+    }
+    let scales = &parts.scales.inverse_cols[..n];
+    let Some(nearest) = nearest(&guess[..n], &mut out[..2 * n], &angles[..n], scales) else {
+        return false;
+    };
+    for (&value, &c) in out[nearest..nearest + n].iter().zip(coordinates) {
+        q[c] = value;
+    }
+    true
+}
+
+/// The rule of [`start`], shared with the straight step (its `choose`): of the two `candidates` (candidate-major, each `guess.len()`
+/// long) for a block at `guess`, the offset (0 or n) of the one the guess takes, after moving
+/// each candidate angle (`angles[j]`) by whole turns to the guess's; `None` near a toggle, away
+/// from both solutions, or where the loop cannot close (NaN). `inverse_cols` scales each
+/// coordinate to scene lengths and radians.
+pub(crate) fn nearest(
+    guess: &[f64],
+    candidates: &mut [f64],
+    angles: &[bool],
+    inverse_cols: &[f64],
+) -> Option<usize> {
+    let n = guess.len();
+    // Per coordinate: each candidate moved to the guess's turn; then the squared scaled
+    // distances from the guess to each candidate and between them.
     let (mut to_first, mut to_second, mut apart) = (0.0, 0.0, 0.0);
-    for (j, (&c, &scale)) in coordinates
-        .iter()
-        .zip(&*parts.scales.inverse_cols)
-        .enumerate()
-    {
-        let guess = q[c];
-        let angle = bs.m.coordinate_unit(c) == Unit::Angle;
+    for (j, ((&guess, &angle), &scale)) in guess.iter().zip(angles).zip(inverse_cols).enumerate() {
         let [first, second] = [j, n + j].map(|k| {
-            let value = out[k];
+            let value = candidates[k];
             // atan2 answers within a turn and a half of 0: most guesses need no rounding.
             if angle && (guess - value).abs() > PI {
-                out[k] = value + TAU * libm::round((guess - value) / TAU);
+                candidates[k] = value + TAU * libm::round((guess - value) / TAU);
             }
-            out[k]
+            candidates[k]
         });
         let [d1, d2, d12] = [first - guess, second - guess, first - second].map(|d| d * scale);
         (to_first, to_second, apart) = (to_first + d1 * d1, to_second + d2 * d2, apart + d12 * d12);
@@ -84,11 +104,5 @@ where
     let clear = far.is_finite()
         && apart >= SEPARATION * SEPARATION
         && near <= CLEAR_FRACTION * CLEAR_FRACTION * apart;
-    if !(unique || clear) {
-        return false;
-    }
-    for (&value, &c) in out[nearest..nearest + n].iter().zip(coordinates) {
-        q[c] = value;
-    }
-    true
+    (unique || clear).then_some(nearest)
 }

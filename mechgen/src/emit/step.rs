@@ -1,0 +1,258 @@
+//! The straight kinematic step as code: for a scene whose every block has a closed form and
+//! which computes no forces, `Structured::straight_step`, one function that runs the stages
+//! in the sweep's order by calling their kernels directly (no dispatch on the stage index),
+//! with the trig cache viewed as its array once. Each block takes its closed-form solution
+//! under the runtime's checks (`::mechgen_runtime::codegen::{choose, StepContext}`), factors
+//! its Jacobian with its static LU and solves its rates with those factors. A failed check
+//! restores the blocks' guesses and returns the stage: the solver then runs the stage sweep.
+
+use proc_macro2::{Ident, Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::body::Context;
+use super::idx;
+use super::plan::Kernel;
+use crate::model::Unit;
+use crate::plan::kernels::{Kernels, Method, StageKernel};
+
+/// The straight step of a scene that can have one: the inherent function that runs the
+/// stages, and the `Structured` method that calls it and restores the guesses when it fails.
+/// `functions` are the kernels' functions, in `kernels.stages` order.
+pub(super) fn straight_step(
+    cx: &Context<'_>,
+    kernels: &Kernels,
+    functions: &[(TokenStream, Kernel)],
+) -> Option<(TokenStream, TokenStream)> {
+    let functions: Vec<&Kernel> = functions.iter().map(|(_, f)| f).collect();
+    if kernels.sizes.forces.is_some() {
+        return None;
+    }
+    let (coordinate_units, equation_units) =
+        (cx.model.coordinate_units(), cx.model.equation_units());
+    let units = Units {
+        coordinates: &coordinate_units,
+        equations: &equation_units,
+    };
+    let mut stages = Vec::new();
+    let mut saved = Vec::new();
+    for (s, shape) in kernels.shapes.iter().enumerate() {
+        let calls = StageCalls::of(kernels, &functions, s);
+        stages.push(match &shape.block {
+            None => calls.explicit(),
+            Some(block) => {
+                saved.extend(&shape.coordinates);
+                block_step(kernels, s, &calls, &units, block.factorization?)?
+            }
+        });
+    }
+    let trig_len = idx(kernels.sizes.trig);
+    // Parameters no kernel reads are named `_t`, `_trig`, `_report`.
+    let reads = |name: &str| functions.iter().any(|f| f.arguments.contains(&name));
+    let unused = |used: bool, name: &str| {
+        let name = if used {
+            name.to_string()
+        } else {
+            format!("_{name}")
+        };
+        format_ident!("{}", name)
+    };
+    let (t, trig, report_param) = (
+        unused(reads("t"), "t"),
+        unused(reads("trig"), "trig"),
+        unused(!saved.is_empty(), "report"),
+    );
+    let view = reads("trig").then(|| {
+        quote! {
+            let ::core::option::Option::Some(trig) = trig.first_chunk_mut::<#trig_len>() else {
+                return ::core::result::Result::Err(0);
+            };
+        }
+    });
+    let (vector, trait_vector) = (
+        cx.vector_type(),
+        quote!(::mechgen_runtime::Vector<Self::Dim>),
+    );
+    let (context, report) = (
+        quote!(::mechgen_runtime::codegen::StepContext),
+        quote!(::mechgen_runtime::codegen::StepReport),
+    );
+    let result = quote!(::core::result::Result<(), usize>);
+    let ok = quote!(::core::result::Result::Ok(()));
+    let (slots, indices): (Vec<Literal>, Vec<Literal>) = saved
+        .iter()
+        .enumerate()
+        .map(|(k, &c)| (idx(k), idx(c)))
+        .unzip();
+    let inherent = quote! {
+        /// The straight kinematic step's stages, in solve order (see
+        /// `Structured::straight_step`).
+        #[allow(clippy::too_many_arguments)]
+        fn straight_stages(
+            &self,
+            #t: f64,
+            q: &mut #vector,
+            qd: &mut #vector,
+            qdd: &mut #vector,
+            #trig: &mut [f64],
+            context: &#context,
+            #report_param: &mut #report,
+        ) -> #result {
+            #view
+            #(#stages)*
+            context.check_rounding(Self::STAGES.len(), q.as_slice(), &Self::COORDINATE_UNITS)?;
+            #ok
+        }
+    };
+    let method = quote! {
+        fn straight_step(
+            &self,
+            t: f64,
+            q: &mut #trait_vector,
+            qd: &mut #trait_vector,
+            qdd: &mut #trait_vector,
+            trig: &mut [f64],
+            context: &#context,
+            report: &mut #report,
+        ) -> #result {
+            let saved = [#(q[#indices]),*];
+            let result = self.straight_stages(t, q, qd, qdd, trig, context, report);
+            if result.is_err() {
+                #(q[#indices] = saved[#slots];)*
+            }
+            result
+        }
+    };
+    Some((inherent, method))
+}
+
+/// The scene's units, by global index.
+struct Units<'a> {
+    coordinates: &'a [Unit],
+    equations: &'a [Unit],
+}
+
+/// A stage's kernel calls, by method.
+struct StageCalls {
+    calls: Vec<(Method, TokenStream)>,
+}
+
+impl StageCalls {
+    /// The calls of stage `s`'s kernels.
+    fn of(kernels: &Kernels, functions: &[&Kernel], s: usize) -> Self {
+        let calls = kernels
+            .stages
+            .iter()
+            .zip(functions)
+            .filter(|(k, _): &(&StageKernel, _)| k.stage == s)
+            .map(|(k, f)| (k.method, f.call()))
+            .collect();
+        Self { calls }
+    }
+
+    /// `call;` for the stage's kernel of `method`, nothing without one.
+    fn call(&self, method: Method) -> TokenStream {
+        let call = self.calls.iter().find(|(m, _)| *m == method);
+        call.map(|(_, c)| quote!(#c;)).unwrap_or_default()
+    }
+
+    /// An explicit stage: positions, trig, velocities, accelerations.
+    fn explicit(&self) -> TokenStream {
+        let calls = [
+            Method::Positions,
+            Method::FillTrig,
+            Method::Velocities,
+            Method::Accelerations,
+        ]
+        .map(|m| self.call(m));
+        quote!(#(#calls)*)
+    }
+}
+
+/// A block's part of the step: candidates → choice → Jacobian and Φ at the choice → scaled
+/// factors → checks → trig → rates by the static LU. `None` for a block without a closed
+/// form.
+fn block_step(
+    kernels: &Kernels,
+    s: usize,
+    calls: &StageCalls,
+    units: &Units<'_>,
+    factorization: usize,
+) -> Option<TokenStream> {
+    let shape = &kernels.shapes[s];
+    let block = shape.block.as_ref()?;
+    if !calls.calls.iter().any(|(m, _)| *m == Method::ClosedForm) {
+        return None;
+    }
+    let n = shape.coordinates.len();
+    let (stage, n_lit, candidates, slots) = (idx(s), idx(n), idx(2 * n), idx(block.slots));
+    let unit = |u: Unit| {
+        let variant = format_ident!("{}", u.name());
+        quote!(::mechgen_runtime::Unit::#variant)
+    };
+    let equation_units = shape.equations.iter().map(|&e| unit(units.equations[e]));
+    let coordinate_units = shape
+        .coordinates
+        .iter()
+        .map(|&c| unit(units.coordinates[c]));
+    let angles = shape
+        .coordinates
+        .iter()
+        .map(|&c| units.coordinates[c] == Unit::Angle);
+    let coordinates: Vec<Literal> = shape.coordinates.iter().map(|&c| idx(c)).collect();
+    let locals: Vec<Literal> = (0..n).map(idx).collect();
+    let pattern = block.pattern.iter().map(|&(i, j)| {
+        let (i, j) = (idx(i), idx(j));
+        quote!((#i, #j))
+    });
+    let pivots = block.pivots.iter().map(|&p| idx(p));
+    let (factor, solve): (Ident, Ident) = (
+        format_ident!("factor_{}", factorization),
+        format_ident!("solve_{}", factorization),
+    );
+    let [closed_form, jacobian, trig, velocity_rhs, acceleration_rhs] = [
+        Method::ClosedForm,
+        Method::Jacobian,
+        Method::FillTrig,
+        Method::VelocityRhs,
+        Method::AccelerationRhs,
+    ]
+    .map(|m| calls.call(m));
+    let scatter = |target: TokenStream| quote!(#(#target[#coordinates] = x[#locals];)*);
+    let (to_q, to_qd, to_qdd) = (
+        scatter(quote!(q)),
+        scatter(quote!(qd)),
+        scatter(quote!(qdd)),
+    );
+    Some(quote! {
+        {
+            let scales = context.scales([#(#equation_units),*], [#(#coordinate_units),*]);
+            let out = &mut [0.0_f64; #candidates];
+            #closed_form
+            let guess = [#(q[#coordinates]),*];
+            let ::core::option::Option::Some(x) =
+                ::mechgen_runtime::codegen::choose(guess, out, [#(#angles),*], &scales)
+            else {
+                return ::core::result::Result::Err(#stage);
+            };
+            #to_q
+            let (phi, values) = (&mut [0.0_f64; #n_lit], &mut [0.0_f64; #slots]);
+            #jacobian
+            let (tiny, norm1) =
+                context.scale_jacobian(#stage, values, &[#(#pattern),*], &scales)?;
+            if Self::#factor(values, tiny, context.limit()).is_err() {
+                return ::core::result::Result::Err(#stage);
+            }
+            let values = &*values;
+            let solve = |x: &mut [f64; #n_lit]| Self::#solve(values, x);
+            context.accept(#stage, phi, &x, &scales, &[#(values[#pivots]),*], norm1, solve, report)?;
+            #trig
+            let out = &mut [0.0_f64; #n_lit];
+            #velocity_rhs
+            let x = context.rates(#stage, out, &scales, solve)?;
+            #to_qd
+            #acceleration_rhs
+            let x = context.rates(#stage, out, &scales, solve)?;
+            #to_qdd
+        }
+    })
+}
