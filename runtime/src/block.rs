@@ -390,6 +390,7 @@ where
 
 /// `‖S⁻¹‖₁` exactly, one solve (`solve`: `x ← S⁻¹ x`) per column, in `x` (n long) as
 /// scratch; NaN propagates.
+#[inline]
 pub(crate) fn exact_inverse_norm(x: &mut [f64], mut solve: impl FnMut(&mut [f64])) -> f64 {
     (0..x.len()).fold(0.0_f64, |largest, j| {
         x.fill(0.0);
@@ -406,6 +407,7 @@ pub(crate) fn exact_inverse_norm(x: &mut [f64], mut solve: impl FnMut(&mut [f64]
 
 /// The block's condition `max(1, ‖S‖₁) ‖S⁻¹‖₁` (see the module documentation), infinite when
 /// it overflows or is NaN.
+#[inline]
 pub(crate) fn bounded_condition(inverse_norm: f64, norm1: f64) -> f64 {
     let condition = inverse_norm * norm1.max(SCALE_FLOOR);
     if condition <= f64::MAX {

@@ -9,8 +9,7 @@ use mechgen_examples::scenes::{FourBar, Hoeken, PistonCrank, QuickReturn};
 use mechgen_examples::stability::{SliderCrank, Unclosable};
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{
-    Accelerations, Mechanism, Simulation, Solver, SolverOptions, State, Storage, Structured,
-    Vector,
+    Accelerations, Mechanism, Simulation, Solver, SolverOptions, State, Storage, Structured, Vector,
 };
 
 /// The options of the stage sweep with its closed-form starts (the straight step off).
@@ -62,9 +61,12 @@ fn agrees_over<M>(
     M: Structured + Accelerations + Clone,
     DefaultAllocator: Storage<M::Dim>,
 {
-    let start = |options| Simulation::new(Solver::with_options(scene.clone(), options), 0.0);
-    let mut straight = start(SolverOptions::default()).expect("assembles");
-    let mut other = start(reference).expect("assembles");
+    let start = |options| {
+        Simulation::new(Solver::with_options(scene.clone(), options), 0.0)
+            .unwrap_or_else(|e| panic!("assembles: {e}"))
+    };
+    let mut straight = start(SolverOptions::default());
+    let mut other = start(reference);
     for i in 1..=steps {
         let t = period * i as f64 / steps as f64;
         let a = straight.step_to(t).unwrap_or_else(|e| panic!("t {t}: {e}"));
@@ -76,10 +78,7 @@ fn agrees_over<M>(
         );
         assert_eq!(a.orientation, b.orientation, "t {t}");
         let errors = levels(a, b);
-        assert!(
-            errors.iter().all(|&e| e < tolerance),
-            "t {t}: {errors:?}"
-        );
+        assert!(errors.iter().all(|&e| e < tolerance), "t {t}: {errors:?}");
     }
 }
 
@@ -109,7 +108,9 @@ fn the_seed_by_straight_steps_matches_its_written_out_closed_form() {
         Simulation::new(Solver::new(PistonCrank::default()), 0.0).expect("assembles");
     for i in 1..=720 {
         let t = hand.period() * f64::from(i) / 720.0;
-        let state = simulation.step_to(t).unwrap_or_else(|e| panic!("t {t}: {e}"));
+        let state = simulation
+            .step_to(t)
+            .unwrap_or_else(|e| panic!("t {t}: {e}"));
         assert_eq!(state.iterations, 0, "t {t}: not a straight step");
         hand.written_out(t, &mut out);
         let levels = [
@@ -189,7 +190,10 @@ fn guesses_the_straight_step_declines_get_exactly_the_sweeps_answer() {
             }
         }
     }
-    assert!(taken > 0 && declined > 0, "taken {taken}, declined {declined}");
+    assert!(
+        taken > 0 && declined > 0,
+        "taken {taken}, declined {declined}"
+    );
 }
 
 #[test]

@@ -200,10 +200,21 @@ impl Kernel {
     }
 }
 
-/// The function of kernel `k`: it takes the state its body reads, the trig cache if it reads
-/// it, and time, then the output parameters its method gives it.
-// Kept whole: the kernel's parameters follow from its body, built just before them.
+/// The function of kernel `k`, named after its method.
 fn kernel_function(cx: &Context<'_>, kernels: &Kernels, k: &StageKernel) -> (TokenStream, Kernel) {
+    named_kernel_function(cx, kernels, k, naming(k.method))
+}
+
+/// The function `stage_{s}_{suffix}` of kernel `k`, documented as doing `description`: it
+/// takes the state its body reads, the trig cache if it reads it, and time, then the output
+/// parameters its method gives it.
+// Kept whole: the kernel's parameters follow from its body, built just before them.
+pub(super) fn named_kernel_function(
+    cx: &Context<'_>,
+    kernels: &Kernels,
+    k: &StageKernel,
+    (suffix, description): (&str, &str),
+) -> (TokenStream, Kernel) {
     let outputs: Vec<(TokenStream, Id)> = k
         .kernel
         .outputs
@@ -233,7 +244,6 @@ fn kernel_function(cx: &Context<'_>, kernels: &Kernels, k: &StageKernel) -> (Tok
             (input, ty)
         })
         .collect();
-    let (suffix, description) = naming(k.method);
     let name = format!("stage_{}_{suffix}", k.stage);
     let f = cx.bounded(&name, &outputs, zeros, &outs, &typed, &k.kernel.cached);
     let mut params = Vec::new();

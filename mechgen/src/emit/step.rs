@@ -11,9 +11,10 @@ use quote::{format_ident, quote};
 
 use super::body::Context;
 use super::idx;
-use super::plan::Kernel;
+use super::plan::{Kernel, named_kernel_function};
 use crate::model::Unit;
 use crate::plan::kernels::{Kernels, Method, StageKernel};
+use crate::plan::trig::Phase;
 
 /// The straight step of a scene that can have one: the inherent function that runs the
 /// stages, and the `Structured` method that calls it and restores the guesses when it fails.
@@ -35,13 +36,21 @@ pub(super) fn straight_step(
     };
     let mut stages = Vec::new();
     let mut saved = Vec::new();
+    let mut variants = Vec::new();
     for (s, shape) in kernels.shapes.iter().enumerate() {
-        let calls = StageCalls::of(kernels, &functions, s);
+        let mut calls = StageCalls::of(kernels, &functions, s);
         stages.push(match &shape.block {
             None => calls.explicit(),
             Some(block) => {
                 saved.extend(&shape.coordinates);
-                block_step(kernels, s, &calls, &units, block.factorization?)?
+                let solved = solved_jacobian(cx, kernels, s);
+                let trig_first = solved.is_some();
+                if let Some((function, kernel)) = solved {
+                    variants.push(function);
+                    calls.replace(Method::Jacobian, kernel.call());
+                }
+                let factorization = block.factorization?;
+                block_step(kernels, s, &calls, &units, factorization, trig_first)?
             }
         });
     }
@@ -102,6 +111,7 @@ pub(super) fn straight_step(
             context.check_rounding(Self::STAGES.len(), q.as_slice(), &Self::COORDINATE_UNITS)?;
             #ok
         }
+        #(#variants)*
     };
     let method = quote! {
         fn straight_step(
@@ -149,6 +159,15 @@ impl StageCalls {
         Self { calls }
     }
 
+    /// Calls `call` for `method` instead of the stage's own kernel.
+    fn replace(&mut self, method: Method, call: TokenStream) {
+        for (m, c) in &mut self.calls {
+            if *m == method {
+                *c = call.clone();
+            }
+        }
+    }
+
     /// `call;` for the stage's kernel of `method`, nothing without one.
     fn call(&self, method: Method) -> TokenStream {
         let call = self.calls.iter().find(|(m, _)| *m == method);
@@ -168,15 +187,41 @@ impl StageCalls {
     }
 }
 
-/// A block's part of the step: candidates → choice → Jacobian and Φ at the choice → scaled
-/// factors → checks → trig → rates by the static LU. `None` for a block without a closed
-/// form.
+/// Block `s`'s Jacobian kernel reading its own angles' sines and cosines from the trig cache
+/// (filled at the chosen solution before it runs), where it has any: the function and its
+/// call. In the straight step the solution is final when the Jacobian is evaluated, so each
+/// angle's `sin_cos` is computed once, by the trig fill, for the Jacobian and the rates.
+fn solved_jacobian(cx: &Context<'_>, kernels: &Kernels, s: usize) -> Option<(TokenStream, Kernel)> {
+    let k = kernels
+        .stages
+        .iter()
+        .find(|k| k.stage == s && k.method == Method::Jacobian)?;
+    let cached = kernels
+        .trig
+        .reads(cx.arena(), &k.kernel.roots, s, Phase::After);
+    if cached.len() == k.kernel.cached.len() {
+        return None;
+    }
+    let mut solved = k.clone();
+    solved.kernel.cached = cached;
+    let naming = (
+        "solved_jacobian",
+        "the block's residual and Jacobian at its solved positions, its own sines and cosines \
+         read from the cache",
+    );
+    Some(named_kernel_function(cx, kernels, &solved, naming))
+}
+
+/// A block's part of the step: candidates → choice → (trig, when the Jacobian reads it) →
+/// Jacobian and Φ at the choice → scaled factors → checks → (trig) → rates by the static LU.
+/// `None` for a block without a closed form.
 fn block_step(
     kernels: &Kernels,
     s: usize,
     calls: &StageCalls,
     units: &Units<'_>,
     factorization: usize,
+    trig_first: bool,
 ) -> Option<TokenStream> {
     let shape = &kernels.shapes[s];
     let block = shape.block.as_ref()?;
@@ -217,6 +262,11 @@ fn block_step(
         Method::AccelerationRhs,
     ]
     .map(|m| calls.call(m));
+    let (trig_before, trig_after) = if trig_first {
+        (trig, TokenStream::new())
+    } else {
+        (TokenStream::new(), trig)
+    };
     let scatter = |target: TokenStream| quote!(#(#target[#coordinates] = x[#locals];)*);
     let (to_q, to_qd, to_qdd) = (
         scatter(quote!(q)),
@@ -235,6 +285,7 @@ fn block_step(
                 return ::core::result::Result::Err(#stage);
             };
             #to_q
+            #trig_before
             let (phi, values) = (&mut [0.0_f64; #n_lit], &mut [0.0_f64; #slots]);
             #jacobian
             let (tiny, norm1) =
@@ -245,7 +296,7 @@ fn block_step(
             let values = &*values;
             let solve = |x: &mut [f64; #n_lit]| Self::#solve(values, x);
             context.accept(#stage, phi, &x, &scales, &[#(values[#pivots]),*], norm1, solve, report)?;
-            #trig
+            #trig_after
             let out = &mut [0.0_f64; #n_lit];
             #velocity_rhs
             let x = context.rates(#stage, out, &scales, solve)?;

@@ -69,6 +69,7 @@ where
 /// each candidate angle (`angles[j]`) by whole turns to the guess's; `None` near a toggle, away
 /// from both solutions, or where the loop cannot close (NaN). `inverse_cols` scales each
 /// coordinate to scene lengths and radians.
+#[inline]
 pub(crate) fn nearest(
     guess: &[f64],
     candidates: &mut [f64],
@@ -80,14 +81,11 @@ pub(crate) fn nearest(
     // distances from the guess to each candidate and between them.
     let (mut to_first, mut to_second, mut apart) = (0.0, 0.0, 0.0);
     for (j, ((&guess, &angle), &scale)) in guess.iter().zip(angles).zip(inverse_cols).enumerate() {
-        let [first, second] = [j, n + j].map(|k| {
-            let value = candidates[k];
-            // atan2 answers within a turn and a half of 0: most guesses need no rounding.
-            if angle && (guess - value).abs() > PI {
-                candidates[k] = value + TAU * libm::round((guess - value) / TAU);
-            }
-            candidates[k]
-        });
+        if angle {
+            to_turn(&mut candidates[j], guess);
+            to_turn(&mut candidates[n + j], guess);
+        }
+        let (first, second) = (candidates[j], candidates[n + j]);
         let [d1, d2, d12] = [first - guess, second - guess, first - second].map(|d| d * scale);
         (to_first, to_second, apart) = (to_first + d1 * d1, to_second + d2 * d2, apart + d12 * d12);
     }
@@ -105,4 +103,13 @@ pub(crate) fn nearest(
         && apart >= SEPARATION * SEPARATION
         && near <= CLEAR_FRACTION * CLEAR_FRACTION * apart;
     (unique || clear).then_some(nearest)
+}
+
+/// Moves the angle `value` by whole turns to the turn of `guess`.
+#[inline]
+fn to_turn(value: &mut f64, guess: f64) {
+    // atan2 answers within a turn and a half of 0: most guesses need no rounding.
+    if (guess - *value).abs() > PI {
+        *value += TAU * libm::round((guess - *value) / TAU);
+    }
 }
