@@ -186,7 +186,8 @@ impl StepContext {
 /// The closed-form solution of a block at `guess` that the sweep would start Newton from:
 /// of the two `candidates` (candidate-major), the nearest, with its angles (`angles[j]`) moved
 /// to the guess's turn; `None` where the sweep would start from the guess itself (near a
-/// toggle, a guess between the solutions, a loop that cannot close).
+/// toggle, a guess between the solutions, a loop that cannot close, or `candidates` not
+/// `2 N` long).
 #[inline]
 pub fn choose<const N: usize, const C: usize>(
     guess: [f64; N],
@@ -194,14 +195,11 @@ pub fn choose<const N: usize, const C: usize>(
     angles: [bool; N],
     scales: &BlockScales<N>,
 ) -> Option<[f64; N]> {
-    let mut candidates = *candidates;
-    if C != 2 * N {
-        return None;
-    }
-    let offset = nearest(&guess, &mut candidates, &angles, &scales.inverse_cols)?;
-    let mut chosen = [0.0; N];
-    chosen.copy_from_slice(&candidates[offset..offset + N]);
-    Some(chosen)
+    let (first, second) = candidates.split_first_chunk::<N>()?;
+    let second = second.first_chunk::<N>().filter(|_| C == 2 * N)?;
+    let mut candidates = [*first, *second];
+    let nearest = nearest(&guess, &mut candidates, &angles, &scales.inverse_cols)?;
+    Some(candidates[nearest])
 }
 
 /// `max |v_j c_j|`, NaN winning.
