@@ -181,9 +181,9 @@ where
     /// accelerations at `t`, each block taking its closed-form solution nearest the guess in
     /// `q` after the checks of [`crate::codegen::StepContext`], and the trig cache filled as
     /// the stage sweep fills it. Generated for a scene whose every block has a closed form
-    /// and which computes no forces. `Err(stage)` where a check fails (or, by default, for a
-    /// scene without one), with the block coordinates of `q` as they were: the solver then
-    /// runs the stage sweep.
+    /// and whose outputs are the accelerations (no forces). `Err(stage)` where a check fails
+    /// (or, by default, for a scene without one), with the block coordinates of `q` as they
+    /// were: the solver then runs the stage sweep.
     #[allow(clippy::too_many_arguments)]
     fn straight_step(
         &self,

@@ -1,5 +1,5 @@
 //! The straight kinematic step as code: for a scene whose every block has a closed form and
-//! which computes no forces, `Structured::straight_step`, one function that runs the stages
+//! whose outputs are the accelerations (no forces), `Structured::straight_step`, one function that runs the stages
 //! in the sweep's order by calling their kernels directly (no dispatch on the stage index),
 //! with the trig cache viewed as its array once. Each block takes its closed-form solution
 //! under the runtime's checks (`::mechgen_runtime::codegen::{choose, StepContext}`), factors
@@ -12,7 +12,7 @@ use quote::{format_ident, quote};
 use super::body::Context;
 use super::idx;
 use super::plan::{Kernel, named_kernel_function};
-use crate::model::Unit;
+use crate::model::{Outputs, Unit};
 use crate::plan::kernels::{Kernels, Method, StageKernel};
 use crate::plan::trig::Phase;
 
@@ -25,7 +25,9 @@ pub(super) fn straight_step(
     functions: &[(TokenStream, Kernel)],
 ) -> Option<(TokenStream, TokenStream)> {
     let functions: Vec<&Kernel> = functions.iter().map(|(_, f)| f).collect();
-    if kernels.sizes.forces.is_some() {
+    // The solver takes the step for a full kinematic solve only (a force solve needs the
+    // factors archived the sweep's way; fewer outputs keep the sweep).
+    if cx.model.outputs != Outputs::Accelerations {
         return None;
     }
     let (coordinate_units, equation_units) =
@@ -113,6 +115,20 @@ pub(super) fn straight_step(
         }
         #(#variants)*
     };
+    let call = quote!(self.straight_stages(t, q, qd, qdd, trig, context, report));
+    // Without blocks, no guess is read: nothing to restore.
+    let body = if saved.is_empty() {
+        call
+    } else {
+        quote! {
+            let saved = [#(q[#indices]),*];
+            let result = #call;
+            if result.is_err() {
+                #(q[#indices] = saved[#slots];)*
+            }
+            result
+        }
+    };
     let method = quote! {
         fn straight_step(
             &self,
@@ -124,12 +140,7 @@ pub(super) fn straight_step(
             context: &#context,
             report: &mut #report,
         ) -> #result {
-            let saved = [#(q[#indices]),*];
-            let result = self.straight_stages(t, q, qd, qdd, trig, context, report);
-            if result.is_err() {
-                #(q[#indices] = saved[#slots];)*
-            }
-            result
+            #body
         }
     };
     Some((inherent, method))
