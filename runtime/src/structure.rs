@@ -182,8 +182,8 @@ where
     /// `q` after the checks of [`crate::codegen::StepContext`], and the trig cache filled as
     /// the stage sweep fills it. Generated for a scene whose every block has a closed form
     /// and whose outputs are the accelerations (no forces). `Err(stage)` where a check fails
-    /// (or, by default, for a scene without one), with the block coordinates of `q` as they
-    /// were: the solver then runs the stage sweep.
+    /// (or, by default, for a scene without one), with `q` as it was: the solver then runs
+    /// the stage sweep.
     #[allow(clippy::too_many_arguments)]
     fn straight_step(
         &self,

@@ -4,7 +4,7 @@
 //! with the trig cache viewed as its array once. Each block takes its closed-form solution
 //! under the runtime's checks (`::mechgen_runtime::codegen::{choose, StepContext}`), factors
 //! its Jacobian with its static LU and solves its rates with those factors. A failed check
-//! restores the blocks' guesses and returns the stage: the solver then runs the stage sweep.
+//! restores the guess and returns the stage: the solver then runs the stage sweep.
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -17,7 +17,7 @@ use crate::plan::kernels::{Kernels, Method, StageKernel};
 use crate::plan::trig::Phase;
 
 /// The straight step of a scene that can have one: the inherent function that runs the
-/// stages, and the `Structured` method that calls it and restores the guesses when it fails.
+/// stages, and the `Structured` method that calls it and restores the guess when it fails.
 /// `functions` are the kernels' functions, in `kernels.stages` order.
 pub(super) fn straight_step(
     cx: &Context<'_>,
@@ -37,14 +37,14 @@ pub(super) fn straight_step(
         equations: &equation_units,
     };
     let mut stages = Vec::new();
-    let mut saved = Vec::new();
+    let mut blocks = false;
     let mut variants = Vec::new();
     for (s, shape) in kernels.shapes.iter().enumerate() {
         let mut calls = StageCalls::of(kernels, &functions, s);
         stages.push(match &shape.block {
             None => calls.explicit(),
             Some(block) => {
-                saved.extend(&shape.coordinates);
+                blocks = true;
                 let solved = solved_jacobian(cx, kernels, s);
                 let trig_first = solved.is_some();
                 if let Some((function, kernel)) = solved {
@@ -70,7 +70,7 @@ pub(super) fn straight_step(
     let (t, trig, report_param) = (
         unused(reads("t"), "t"),
         unused(reads("trig"), "trig"),
-        unused(!saved.is_empty(), "report"),
+        unused(blocks, "report"),
     );
     let view = reads("trig").then(|| {
         quote! {
@@ -89,11 +89,6 @@ pub(super) fn straight_step(
     );
     let result = quote!(::core::result::Result<(), usize>);
     let ok = quote!(::core::result::Result::Ok(()));
-    let (slots, indices): (Vec<Literal>, Vec<Literal>) = saved
-        .iter()
-        .enumerate()
-        .map(|(k, &c)| (idx(k), idx(c)))
-        .unzip();
     let inherent = quote! {
         /// The straight kinematic step's stages, in solve order (see
         /// `Structured::straight_step`).
@@ -115,20 +110,6 @@ pub(super) fn straight_step(
         }
         #(#variants)*
     };
-    let call = quote!(self.straight_stages(t, q, qd, qdd, trig, context, report));
-    // Without blocks, no guess is read: nothing to restore.
-    let body = if saved.is_empty() {
-        call
-    } else {
-        quote! {
-            let saved = [#(q[#indices]),*];
-            let result = #call;
-            if result.is_err() {
-                #(q[#indices] = saved[#slots];)*
-            }
-            result
-        }
-    };
     let method = quote! {
         fn straight_step(
             &self,
@@ -140,7 +121,13 @@ pub(super) fn straight_step(
             context: &#context,
             report: &mut #report,
         ) -> #result {
-            #body
+            // The sweep that runs where the step fails checks and reads the guess as given.
+            let guess = *q;
+            let result = self.straight_stages(t, q, qd, qdd, trig, context, report);
+            if result.is_err() {
+                *q = guess;
+            }
+            result
         }
     };
     Some((inherent, method))
