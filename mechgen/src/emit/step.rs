@@ -57,7 +57,7 @@ pub(super) fn straight_step(
         });
     }
     let trig_len = idx(kernels.sizes.trig);
-    // Parameters no kernel reads are named `_t`, `_trig`, `_report`.
+    // Parameters no kernel reads are named `_t`, `_report`.
     let reads = |name: &str| functions.iter().any(|f| f.arguments.contains(&name));
     let unused = |used: bool, name: &str| {
         let name = if used {
@@ -67,14 +67,10 @@ pub(super) fn straight_step(
         };
         format_ident!("{}", name)
     };
-    let (t, trig, report_param) = (
-        unused(reads("t"), "t"),
-        unused(reads("trig"), "trig"),
-        unused(blocks, "report"),
-    );
+    let (t, report_param) = (unused(reads("t"), "t"), unused(blocks, "report"));
     let view = reads("trig").then(|| {
         quote! {
-            let ::core::option::Option::Some(trig) = trig.first_chunk_mut::<#trig_len>() else {
+            let ::core::option::Option::Some(trig) = trig_cache.first_chunk_mut::<#trig_len>() else {
                 return ::core::result::Result::Err(0);
             };
         }
@@ -99,13 +95,15 @@ pub(super) fn straight_step(
             q: &mut #vector,
             qd: &mut #vector,
             qdd: &mut #vector,
-            #trig: &mut [f64],
+            trig_cache: &mut [f64],
             context: &#context,
             #report_param: &mut #report,
         ) -> #result {
             #view
             #(#stages)*
-            context.check_rounding(Self::STAGES.len(), q.as_slice(), &Self::COORDINATE_UNITS)?;
+            let end = Self::STAGES.len();
+            context.check_rounding(end, q.as_slice(), &Self::COORDINATE_UNITS)?;
+            context.check_end(end, self, [q, qd, qdd], trig_cache)?;
             #ok
         }
         #(#variants)*

@@ -16,11 +16,40 @@
 use crate::acceptance::COEFFICIENT_ROOM;
 use crate::block::{SCALE_FLOOR, bounded_condition, exact_inverse_norm};
 use crate::block_signs::block_code;
-use crate::mechanism::Unit;
+use nalgebra::DefaultAllocator;
+
+use crate::finite::all_finite;
+use crate::mechanism::{Storage, Unit, Vector};
 use crate::position::nearest;
 use crate::step::{BlockScales, StepContext, StepReport};
+use crate::structure::Structured;
 
 impl StepContext {
+    /// The sweep's end checks at the step's solution: every position and rate finite, every
+    /// branch invariant of `m` positive (read from the filled trig cache `trig`).
+    ///
+    /// # Errors
+    /// `stage` (the stage count) where one fails: the sweep reports it.
+    pub fn check_end<M: Structured>(
+        &self,
+        stage: usize,
+        m: &M,
+        [q, qd, qdd]: [&Vector<M::Dim>; 3],
+        trig: &[f64],
+    ) -> Result<(), usize>
+    where
+        DefaultAllocator: Storage<M::Dim>,
+    {
+        let finite = [q, qd, qdd].iter().all(|v| all_finite(v.as_slice()));
+        // NaN is not positive either.
+        let branches = (0..m.branch_count()).all(|b| m.branch(b, q, trig) > 0.0);
+        if finite && branches {
+            Ok(())
+        } else {
+            Err(stage)
+        }
+    }
+
     /// The unit scales of a block with these equation and coordinate units.
     #[inline]
     pub fn scales<const N: usize>(

@@ -6,7 +6,6 @@
 use nalgebra::DefaultAllocator;
 
 use super::api::Solver;
-use super::checks::check_branches;
 use super::convergence::Convergence;
 
 use crate::error::{Quantity, SolveError};
@@ -26,7 +25,8 @@ where
     /// `Ok(None)` when the stage sweep must (no straight step; it, closed forms or static
     /// pivots switched off; forces or fewer rates asked for; a check declined). The guess is
     /// then as it was, or, past a declined end check, the step's positions, from which every
-    /// block takes the same closed-form solution.
+    /// block takes the same closed-form solution (non-finite markers, which the sweep reports
+    /// from the same positions).
     ///
     /// # Errors
     /// The sweep's input checks: a non-finite `t` or guess, an invalid parameter.
@@ -58,14 +58,7 @@ where
         {
             return Ok(None);
         }
-        // The sweep's end checks (its finiteness of positions and rates, in one pass each);
-        // a failure is left to the sweep to report as it does.
-        let finite = [q.as_slice(), qd.as_slice(), qdd.as_slice()]
-            .iter()
-            .all(|v| all_finite(v));
-        if !finite || check_branches(m, q, parts.trig, t).is_err() {
-            return Ok(None);
-        }
+        // The step made the sweep's end checks (`StepContext::check_end`) but the markers'.
         if !state.markers.as_ref().is_empty() {
             m.markers(q, parts.trig, qd, qdd, t, &mut state.markers);
             if !all_finite(state.markers.as_ref()) {
