@@ -24,101 +24,122 @@ pub(super) fn straight_step(
     kernels: &Kernels,
     functions: &[(TokenStream, Kernel)],
 ) -> Option<(TokenStream, TokenStream)> {
-    let functions: Vec<&Kernel> = functions.iter().map(|(_, f)| f).collect();
     // The solver takes the step for a full kinematic solve only (a force solve needs the
     // factors archived the sweep's way; fewer outputs keep the sweep).
     if cx.model.outputs != Outputs::Accelerations {
         return None;
     }
-    let (coordinate_units, equation_units) =
-        (cx.model.coordinate_units(), cx.model.equation_units());
-    let units = Units {
-        coordinates: &coordinate_units,
-        equations: &equation_units,
-    };
-    let mut stages = Vec::new();
-    let mut blocks = false;
-    let mut variants = Vec::new();
-    for (s, shape) in kernels.shapes.iter().enumerate() {
-        let mut calls = StageCalls::of(kernels, &functions, s);
-        stages.push(match &shape.block {
-            None => calls.explicit(),
-            Some(block) => {
-                blocks = true;
-                let solved = solved_jacobian(cx, kernels, s);
-                let trig_first = solved.is_some();
-                if let Some((function, kernel)) = solved {
-                    variants.push(function);
-                    calls.replace(Method::Jacobian, kernel.call());
+    let functions: Vec<&Kernel> = functions.iter().map(|(_, f)| f).collect();
+    let stages = Stages::of(cx, kernels, &functions)?;
+    Some((stages.function(cx, kernels, &functions), trait_method()))
+}
+
+/// The step's stages as code, and the Jacobian variants its blocks call.
+struct Stages {
+    code: Vec<TokenStream>,
+    variants: Vec<TokenStream>,
+    blocks: bool,
+}
+
+impl Stages {
+    /// Every stage's part of the step; `None` if a block has no closed form or static LU.
+    fn of(cx: &Context<'_>, kernels: &Kernels, functions: &[&Kernel]) -> Option<Self> {
+        let (coordinate_units, equation_units) =
+            (cx.model.coordinate_units(), cx.model.equation_units());
+        let units = Units {
+            coordinates: &coordinate_units,
+            equations: &equation_units,
+        };
+        let mut stages = Stages {
+            code: Vec::new(),
+            variants: Vec::new(),
+            blocks: false,
+        };
+        for (s, shape) in kernels.shapes.iter().enumerate() {
+            let mut calls = StageCalls::of(kernels, functions, s);
+            stages.code.push(match &shape.block {
+                None => calls.explicit(),
+                Some(block) => {
+                    stages.blocks = true;
+                    let solved = solved_jacobian(cx, kernels, s);
+                    let trig_first = solved.is_some();
+                    if let Some((function, kernel)) = solved {
+                        stages.variants.push(function);
+                        calls.replace(Method::Jacobian, kernel.call());
+                    }
+                    let factorization = block.factorization?;
+                    block_step(kernels, s, &calls, &units, factorization, trig_first)?
                 }
-                let factorization = block.factorization?;
-                block_step(kernels, s, &calls, &units, factorization, trig_first)?
+            });
+        }
+        Some(stages)
+    }
+
+    /// `straight_stages`, the inherent function that runs them, then the end checks; and the
+    /// Jacobian variants. Parameters no kernel reads are named `_t`, `_report`.
+    fn function(&self, cx: &Context<'_>, kernels: &Kernels, functions: &[&Kernel]) -> TokenStream {
+        let reads = |name: &str| functions.iter().any(|f| f.arguments.contains(&name));
+        let unused = |used: bool, name: &str| {
+            let name = if used {
+                name.to_string()
+            } else {
+                format!("_{name}")
+            };
+            format_ident!("{}", name)
+        };
+        let (t, report) = (unused(reads("t"), "t"), unused(self.blocks, "report"));
+        let trig_len = idx(kernels.sizes.trig);
+        let view = reads("trig").then(|| {
+            quote! {
+                let ::core::option::Option::Some(trig) =
+                    trig_cache.first_chunk_mut::<#trig_len>()
+                else {
+                    return ::core::result::Result::Err(0);
+                };
             }
         });
-    }
-    let trig_len = idx(kernels.sizes.trig);
-    // Parameters no kernel reads are named `_t`, `_report`.
-    let reads = |name: &str| functions.iter().any(|f| f.arguments.contains(&name));
-    let unused = |used: bool, name: &str| {
-        let name = if used {
-            name.to_string()
-        } else {
-            format!("_{name}")
-        };
-        format_ident!("{}", name)
-    };
-    let (t, report_param) = (unused(reads("t"), "t"), unused(blocks, "report"));
-    let view = reads("trig").then(|| {
+        let vector = cx.vector_type();
+        let (stages, variants) = (&self.code, &self.variants);
         quote! {
-            let ::core::option::Option::Some(trig) = trig_cache.first_chunk_mut::<#trig_len>() else {
-                return ::core::result::Result::Err(0);
-            };
+            /// The straight kinematic step's stages, in solve order (see
+            /// `Structured::straight_step`).
+            #[allow(clippy::too_many_arguments)]
+            fn straight_stages(
+                &self,
+                #t: f64,
+                q: &mut #vector,
+                qd: &mut #vector,
+                qdd: &mut #vector,
+                trig_cache: &mut [f64],
+                context: &::mechgen_runtime::codegen::StepContext,
+                #report: &mut ::mechgen_runtime::codegen::StepReport,
+            ) -> ::core::result::Result<(), usize> {
+                #view
+                #(#stages)*
+                let end = Self::STAGES.len();
+                context.check_rounding(end, q.as_slice(), &Self::COORDINATE_UNITS)?;
+                context.check_end(end, self, [q, qd, qdd], trig_cache)?;
+                ::core::result::Result::Ok(())
+            }
+            #(#variants)*
         }
-    });
-    let (vector, trait_vector) = (
-        cx.vector_type(),
-        quote!(::mechgen_runtime::Vector<Self::Dim>),
-    );
-    let (context, report) = (
-        quote!(::mechgen_runtime::codegen::StepContext),
-        quote!(::mechgen_runtime::codegen::StepReport),
-    );
-    let result = quote!(::core::result::Result<(), usize>);
-    let ok = quote!(::core::result::Result::Ok(()));
-    let inherent = quote! {
-        /// The straight kinematic step's stages, in solve order (see
-        /// `Structured::straight_step`).
-        #[allow(clippy::too_many_arguments)]
-        fn straight_stages(
-            &self,
-            #t: f64,
-            q: &mut #vector,
-            qd: &mut #vector,
-            qdd: &mut #vector,
-            trig_cache: &mut [f64],
-            context: &#context,
-            #report_param: &mut #report,
-        ) -> #result {
-            #view
-            #(#stages)*
-            let end = Self::STAGES.len();
-            context.check_rounding(end, q.as_slice(), &Self::COORDINATE_UNITS)?;
-            context.check_end(end, self, [q, qd, qdd], trig_cache)?;
-            #ok
-        }
-        #(#variants)*
-    };
-    let method = quote! {
+    }
+}
+
+/// `Structured::straight_step`: the stages, with the guess restored where they fail.
+fn trait_method() -> TokenStream {
+    let vector = quote!(::mechgen_runtime::Vector<Self::Dim>);
+    quote! {
         fn straight_step(
             &self,
             t: f64,
-            q: &mut #trait_vector,
-            qd: &mut #trait_vector,
-            qdd: &mut #trait_vector,
+            q: &mut #vector,
+            qd: &mut #vector,
+            qdd: &mut #vector,
             trig: &mut [f64],
-            context: &#context,
-            report: &mut #report,
-        ) -> #result {
+            context: &::mechgen_runtime::codegen::StepContext,
+            report: &mut ::mechgen_runtime::codegen::StepReport,
+        ) -> ::core::result::Result<(), usize> {
             // The sweep that runs where the step fails checks and reads the guess as given.
             let guess = *q;
             let result = self.straight_stages(t, q, qd, qdd, trig, context, report);
@@ -127,8 +148,7 @@ pub(super) fn straight_step(
             }
             result
         }
-    };
-    Some((inherent, method))
+    }
 }
 
 /// The scene's units, by global index.
@@ -211,6 +231,7 @@ fn solved_jacobian(cx: &Context<'_>, kernels: &Kernels, s: usize) -> Option<(Tok
 /// A block's part of the step: candidates → choice → (trig, when the Jacobian reads it) →
 /// Jacobian and Φ at the choice → scaled factors → checks → (trig) → rates by the static LU.
 /// `None` for a block without a closed form.
+// Kept whole: most of it is the block's template, which reads best in one piece.
 fn block_step(
     kernels: &Kernels,
     s: usize,
