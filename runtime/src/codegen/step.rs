@@ -9,15 +9,16 @@
 //! pivots under the same thresholds ([`StepContext::scale_jacobian`]), and the solution must
 //! pass what Newton's first iteration from it would check ([`StepContext::accept`]): a
 //! residual within the tolerances, a Newton correction within the step tolerance (so the
-//! sweep would stop there), and the condition limit. Any check that fails makes the step
-//! return `Err(stage)`; the solver then runs the stage sweep from the original guess, whose
+//! sweep would stop there), and the condition limit; the whole solution passes the sweep's end
+//! checks ([`StepContext::check_rounding`], [`StepContext::check_end`]). Any check that fails
+//! makes the step return `Err(stage)`; the solver then runs the stage sweep from the original guess, whose
 //! answers and errors are unchanged.
+
+use nalgebra::DefaultAllocator;
 
 use crate::acceptance::COEFFICIENT_ROOM;
 use crate::block::{SCALE_FLOOR, bounded_condition, exact_inverse_norm};
 use crate::block_signs::block_code;
-use nalgebra::DefaultAllocator;
-
 use crate::finite::all_finite;
 use crate::mechanism::{Storage, Unit, Vector};
 use crate::position::nearest;
