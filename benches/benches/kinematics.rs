@@ -309,17 +309,24 @@ fn closed<F: Clone, R>(
 }
 
 /// A scene's steps as a user takes them (`Solver::new`: default options, every safeguard on)
-/// under `{scene}/default`, and the same on Newton's path alone (closed-form groups off) under
-/// `{scene}/newton`: what the closed forms save, measured in the same run.
+/// under `{scene}/default`, the stage sweep with its closed-form starts (the straight step off)
+/// under `{scene}/sweep`, and Newton's path alone (closed-form groups off) under
+/// `{scene}/newton`: what the straight step and the closed forms save, measured in one run.
 fn closed_forms<M>(c: &mut Criterion, fastest: &Fastest, scene: &str, mechanism: M, period: f64)
 where
     M: Structured + Clone,
     M::Workspace: Clone,
     DefaultAllocator: Storage<M::Dim>,
 {
-    for (method, closed_forms) in [("default", true), ("newton", false)] {
+    let variants = [
+        ("default", true, true),
+        ("sweep", true, false),
+        ("newton", false, true),
+    ];
+    for (method, closed_forms, straight_step) in variants {
         let options = SolverOptions {
             closed_forms,
+            straight_step,
             ..SolverOptions::default()
         };
         let label = format!("{scene}/{method}");

@@ -341,18 +341,8 @@ where
             return 1.0;
         }
         let inverse_norm = if n <= EXACT_CONDITION {
-            let x = &mut estimator.x[..n];
-            (0..n).fold(0.0_f64, |largest, j| {
-                x.fill(0.0);
-                x[j] = 1.0;
+            exact_inverse_norm(&mut estimator.x[..n], |x| {
                 self.solve_scaled(factors, storage, x);
-                let norm: f64 = x.iter().map(|v| v.abs()).sum();
-                // NaN propagates.
-                if norm > largest || norm.is_nan() {
-                    norm
-                } else {
-                    largest
-                }
             })
         } else {
             let (inverse_norm, column) = lu::inverse_one_norm_estimate(
@@ -365,13 +355,7 @@ where
             *hint = column;
             inverse_norm
         };
-        let condition = inverse_norm * factors.norm1().max(SCALE_FLOOR);
-        // Also catches NaN.
-        if condition <= f64::MAX {
-            condition
-        } else {
-            f64::INFINITY
-        }
+        bounded_condition(inverse_norm, factors.norm1())
     }
 
     /// The rank-revealing diagnosis of the block at `q`: complete pivoting on the scaled block
@@ -411,6 +395,35 @@ where
         crate::lu::sort_indices(&mut rows[..deficiency]);
         crate::lu::sort_indices(&mut columns[..deficiency]);
         Ok(deficiency)
+    }
+}
+
+/// `‖S⁻¹‖₁` exactly, one solve (`solve`: `x ← S⁻¹ x`) per column, in `x` (n long) as
+/// scratch; NaN propagates.
+#[inline]
+pub(crate) fn exact_inverse_norm(x: &mut [f64], mut solve: impl FnMut(&mut [f64])) -> f64 {
+    (0..x.len()).fold(0.0_f64, |largest, j| {
+        x.fill(0.0);
+        x[j] = 1.0;
+        solve(x);
+        let norm: f64 = x.iter().map(|v| v.abs()).sum();
+        if norm > largest || norm.is_nan() {
+            norm
+        } else {
+            largest
+        }
+    })
+}
+
+/// The block's condition `max(1, ‖S‖₁) ‖S⁻¹‖₁` (see the module documentation), infinite when
+/// it overflows or is NaN.
+#[inline]
+pub(crate) fn bounded_condition(inverse_norm: f64, norm1: f64) -> f64 {
+    let condition = inverse_norm * norm1.max(SCALE_FLOOR);
+    if condition <= f64::MAX {
+        condition
+    } else {
+        f64::INFINITY
     }
 }
 

@@ -87,6 +87,7 @@ mod reactions;
 mod simulate;
 mod solver;
 mod state;
+mod step;
 mod structure;
 mod workspace;
 

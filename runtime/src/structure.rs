@@ -9,6 +9,7 @@
 use nalgebra::DefaultAllocator;
 
 use crate::mechanism::{Mechanism, Storage, Vector};
+use crate::step::{StepContext, StepReport};
 use crate::workspace::Workspace;
 
 /// One stage of a solve, in solve order. Every coordinate belongs to exactly one stage.
@@ -174,6 +175,27 @@ where
         _t: f64,
         _out: &mut [f64],
     ) {
+    }
+
+    /// The straight kinematic step: every stage in order, positions, velocities and
+    /// accelerations at `t`, each block taking its closed-form solution nearest the guess in
+    /// `q` after the checks of [`crate::codegen::StepContext`], and the trig cache filled as
+    /// the stage sweep fills it. Generated for a scene whose every block has a closed form
+    /// and whose outputs are the accelerations (no forces). `Err(stage)` where a check fails
+    /// (or, by default, for a scene without one), with `q` as it was: the solver then runs
+    /// the stage sweep.
+    #[allow(clippy::too_many_arguments)]
+    fn straight_step(
+        &self,
+        _t: f64,
+        _q: &mut Vector<Self::Dim>,
+        _qd: &mut Vector<Self::Dim>,
+        _qdd: &mut Vector<Self::Dim>,
+        _trig: &mut [f64],
+        _context: &StepContext,
+        _report: &mut StepReport,
+    ) -> Result<(), usize> {
+        Err(0)
     }
 
     /// Writes the sines and cosines of the angles stage `stage` solved into the trig cache, once

@@ -17,6 +17,7 @@ mod markers;
 mod motion;
 mod plan;
 mod stages;
+mod step;
 
 use std::cell::RefCell;
 use std::collections::HashMap;

@@ -11,6 +11,7 @@ use super::dispatch::Dispatch;
 use super::idx;
 use super::lu::lu_functions;
 use super::stages::stage_table;
+use super::step::straight_step;
 use crate::expr::Id;
 use crate::plan::kernels::{Buffer, Kernels, Method, StageKernel};
 use crate::plan::structure::Plan;
@@ -75,6 +76,7 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan, kernels: &Kernels) 
         .enumerate()
         .flat_map(|(k, f)| lu_functions(cx, k, f));
     let branch = branch_method(cx, kernels);
+    let (straight_stages, straight_step) = straight_step(cx, kernels, &functions).unzip();
     let markers = cx.markers_method(kernels);
     let functions = functions.iter().map(|(function, _)| function);
     let (b, s, k, n) = (
@@ -93,6 +95,7 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan, kernels: &Kernels) 
             #table
             #(#functions)*
             #(#factor_functions)*
+            #straight_stages
         }
 
         impl ::mechgen_runtime::Structured for #name {
@@ -111,6 +114,7 @@ pub(super) fn structured_impl(cx: &Context<'_>, plan: &Plan, kernels: &Kernels) 
             }
 
             #(#methods)*
+            #straight_step
             #branch
             #markers
         }
@@ -182,24 +186,35 @@ fn signature(item: Item) -> (Vec<(&'static str, TokenStream)>, Option<TokenStrea
 
 /// A kernel's function as generated: its name, and the arguments its caller passes (by name,
 /// in order).
-struct Kernel {
+pub(super) struct Kernel {
     function: Ident,
-    arguments: Vec<&'static str>,
+    pub(super) arguments: Vec<&'static str>,
 }
 
 impl Kernel {
     /// `self.function(arguments…)`.
-    fn call(&self) -> TokenStream {
+    pub(super) fn call(&self) -> TokenStream {
         let function = &self.function;
         let arguments = self.arguments.iter().map(|a| format_ident!("{}", a));
         quote!(self.#function(#(#arguments),*))
     }
 }
 
-/// The function of kernel `k`: it takes the state its body reads, the trig cache if it reads
-/// it, and time, then the output parameters its method gives it.
-// Kept whole: the kernel's parameters follow from its body, built just before them.
+/// The function of kernel `k`, named after its method.
 fn kernel_function(cx: &Context<'_>, kernels: &Kernels, k: &StageKernel) -> (TokenStream, Kernel) {
+    named_kernel_function(cx, kernels, k, naming(k.method))
+}
+
+/// The function `stage_{s}_{suffix}` of kernel `k`, documented as doing `description`: it
+/// takes the state its body reads, the trig cache if it reads it, and time, then the output
+/// parameters its method gives it.
+// Kept whole: the kernel's parameters follow from its body, built just before them.
+pub(super) fn named_kernel_function(
+    cx: &Context<'_>,
+    kernels: &Kernels,
+    k: &StageKernel,
+    (suffix, description): (&str, &str),
+) -> (TokenStream, Kernel) {
     let outputs: Vec<(TokenStream, Id)> = k
         .kernel
         .outputs
@@ -229,7 +244,6 @@ fn kernel_function(cx: &Context<'_>, kernels: &Kernels, k: &StageKernel) -> (Tok
             (input, ty)
         })
         .collect();
-    let (suffix, description) = naming(k.method);
     let name = format!("stage_{}_{suffix}", k.stage);
     let f = cx.bounded(&name, &outputs, zeros, &outs, &typed, &k.kernel.cached);
     let mut params = Vec::new();

@@ -43,38 +43,71 @@ pub(crate) fn start<M: Structured>(
 where
     DefaultAllocator: Storage<M::Dim>,
 {
-    let n = bs.n();
-    if n > MAX_SIZE {
-        return false;
+    match bs.n() {
+        1 => start_sized::<M, 1>(bs, parts, q, t),
+        MAX_SIZE => start_sized::<M, MAX_SIZE>(bs, parts, q, t),
+        _ => false,
     }
-    let mut out = [f64::NAN; 2 * MAX_SIZE];
-    bs.m.closed_form(bs.stage, q, parts.trig, t, &mut out[..2 * n]);
+}
+
+/// [`start`] for a block of `N` coordinates.
+fn start_sized<M: Structured, const N: usize>(
+    bs: &BlockSolve<'_, M>,
+    parts: &Parts<'_>,
+    q: &mut Vector<M::Dim>,
+    t: f64,
+) -> bool
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let mut candidates = [[f64::NAN; N]; 2];
+    bs.m.closed_form(bs.stage, q, parts.trig, t, candidates.as_flattened_mut());
     let coordinates = bs.block.coordinates;
-    // Per coordinate: the guess, its scale, and each candidate moved to the guess's turn;
-    // then the squared scaled distances from the guess to each candidate and between them.
+    let (mut guess, mut angles, mut scales) = ([0.0; N], [false; N], [0.0; N]);
+    for (j, &c) in coordinates.iter().enumerate().take(N) {
+        (guess[j], angles[j]) = (q[c], bs.m.coordinate_unit(c) == Unit::Angle);
+    }
+    for (s, &c) in scales.iter_mut().zip(&*parts.scales.inverse_cols) {
+        *s = c;
+    }
+    let Some(nearest) = nearest(&guess, &mut candidates, &angles, &scales) else {
+        return false;
+    };
+    for (&value, &c) in candidates[nearest].iter().zip(coordinates) {
+        q[c] = value;
+    }
+    true
+}
+
+/// The rule of [`start`], shared with the straight step (its `choose`): of the two
+/// `candidates` of a block at `guess`, the one (0 or 1) the guess takes, after moving each
+/// candidate angle (`angles[j]`) by whole turns to the guess's; `None` near a toggle, away
+/// from both solutions, or where the loop cannot close (NaN). `inverse_cols` scales each
+/// coordinate to scene lengths and radians.
+#[inline]
+pub(crate) fn nearest<const N: usize>(
+    guess: &[f64; N],
+    candidates: &mut [[f64; N]; 2],
+    angles: &[bool; N],
+    inverse_cols: &[f64; N],
+) -> Option<usize> {
+    // Per coordinate: each candidate moved to the guess's turn; then the squared scaled
+    // distances from the guess to each candidate and between them.
     let (mut to_first, mut to_second, mut apart) = (0.0, 0.0, 0.0);
-    for (j, (&c, &scale)) in coordinates
-        .iter()
-        .zip(&*parts.scales.inverse_cols)
-        .enumerate()
-    {
-        let guess = q[c];
-        let angle = bs.m.coordinate_unit(c) == Unit::Angle;
-        let [first, second] = [j, n + j].map(|k| {
-            let value = out[k];
-            // atan2 answers within a turn and a half of 0: most guesses need no rounding.
-            if angle && (guess - value).abs() > PI {
-                out[k] = value + TAU * libm::round((guess - value) / TAU);
-            }
-            out[k]
-        });
+    for j in 0..N {
+        let (guess, scale) = (guess[j], inverse_cols[j]);
+        if angles[j] {
+            to_turn(&mut candidates[0][j], guess);
+            to_turn(&mut candidates[1][j], guess);
+        }
+        let (first, second) = (candidates[0][j], candidates[1][j]);
         let [d1, d2, d12] = [first - guess, second - guess, first - second].map(|d| d * scale);
         (to_first, to_second, apart) = (to_first + d1 * d1, to_second + d2 * d2, apart + d12 * d12);
     }
     let (nearest, near, far) = if to_first <= to_second {
         (0, to_first, to_second)
     } else {
-        (n, to_second, to_first)
+        (1, to_second, to_first)
     };
     // Only a guess well inside the nearest solution's neighbourhood takes it, and only away
     // from a toggle: where the solutions merge, Newton's own choice from the guess stands, as
@@ -84,11 +117,14 @@ where
     let clear = far.is_finite()
         && apart >= SEPARATION * SEPARATION
         && near <= CLEAR_FRACTION * CLEAR_FRACTION * apart;
-    if !(unique || clear) {
-        return false;
+    (unique || clear).then_some(nearest)
+}
+
+/// Moves the angle `value` by whole turns to the turn of `guess`.
+#[inline]
+fn to_turn(value: &mut f64, guess: f64) {
+    // atan2 answers within a turn and a half of 0: most guesses need no rounding.
+    if (guess - *value).abs() > PI {
+        *value += TAU * libm::round((guess - *value) / TAU);
     }
-    for (&value, &c) in out[nearest..nearest + n].iter().zip(coordinates) {
-        q[c] = value;
-    }
-    true
 }

@@ -32,6 +32,7 @@ mod marquardt;
 mod newton;
 mod norms;
 
+pub(crate) use closed::nearest;
 pub(crate) use newton::{Newton, Solved};
 
 /// Armijo constant: a step of length α must reduce the merit ‖D_r Φ_b‖₂ by at least this · α.

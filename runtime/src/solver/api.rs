@@ -210,17 +210,21 @@ where
         self.check_len(&state.accelerations)?;
         self.check_len(&state.reactions)?;
         let rates = Rates::of(self.mechanism.outputs());
-        let convergence = self.solve_stages(
-            t,
-            &mut state.q,
-            &mut state.velocities,
-            &mut state.accelerations,
-            rates,
-            Some(Extras {
-                reactions: &mut state.reactions,
-                markers: &mut state.markers,
-            }),
-        )?;
+        let straight = self.straight_solve(t, state, rates)?;
+        let convergence = match straight {
+            Some(convergence) => convergence,
+            None => self.solve_stages(
+                t,
+                &mut state.q,
+                &mut state.velocities,
+                &mut state.accelerations,
+                rates,
+                Some(Extras {
+                    reactions: &mut state.reactions,
+                    markers: &mut state.markers,
+                }),
+            )?,
+        };
         state.t = t;
         state.iterations = convergence.iterations;
         state.condition = convergence.condition;

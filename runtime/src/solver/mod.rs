@@ -15,6 +15,7 @@ mod convergence;
 mod diagnosis;
 mod rates;
 mod scale;
+mod straight;
 mod sweep;
 
 pub use api::Solver;

@@ -1,0 +1,326 @@
+//! The straight kinematic step as code: for a scene whose every block has a closed form and
+//! whose outputs are the accelerations (no forces), `Structured::straight_step`, one function that runs the stages
+//! in the sweep's order by calling their kernels directly (no dispatch on the stage index),
+//! with the trig cache viewed as its array once. Each block takes its closed-form solution
+//! under the runtime's checks (`::mechgen_runtime::codegen::{choose, StepContext}`), factors
+//! its Jacobian with its static LU and solves its rates with those factors. A failed check
+//! restores the guess and returns the stage: the solver then runs the stage sweep.
+
+use proc_macro2::{Ident, Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::body::Context;
+use super::idx;
+use super::plan::{Kernel, named_kernel_function};
+use crate::model::{Outputs, Unit};
+use crate::plan::kernels::{Kernels, Method, StageKernel};
+use crate::plan::trig::Phase;
+
+/// The straight step of a scene that can have one: the inherent function that runs the
+/// stages, and the `Structured` method that calls it and restores the guess when it fails.
+/// `functions` are the kernels' functions, in `kernels.stages` order.
+pub(super) fn straight_step(
+    cx: &Context<'_>,
+    kernels: &Kernels,
+    functions: &[(TokenStream, Kernel)],
+) -> Option<(TokenStream, TokenStream)> {
+    // The solver takes the step for a full kinematic solve only (a force solve needs the
+    // factors archived the sweep's way; fewer outputs keep the sweep).
+    if cx.model.outputs != Outputs::Accelerations {
+        return None;
+    }
+    let functions: Vec<&Kernel> = functions.iter().map(|(_, f)| f).collect();
+    let stages = Stages::of(cx, kernels, &functions)?;
+    Some((stages.function(cx, kernels, &functions), trait_method()))
+}
+
+/// The step's stages as code, and the Jacobian variants its blocks call.
+struct Stages {
+    code: Vec<TokenStream>,
+    variants: Vec<TokenStream>,
+    blocks: bool,
+}
+
+impl Stages {
+    /// Every stage's part of the step; `None` if a block has no closed form or static LU.
+    fn of(cx: &Context<'_>, kernels: &Kernels, functions: &[&Kernel]) -> Option<Self> {
+        let (coordinate_units, equation_units) =
+            (cx.model.coordinate_units(), cx.model.equation_units());
+        let units = Units {
+            coordinates: &coordinate_units,
+            equations: &equation_units,
+        };
+        let mut stages = Stages {
+            code: Vec::new(),
+            variants: Vec::new(),
+            blocks: false,
+        };
+        for (s, shape) in kernels.shapes.iter().enumerate() {
+            let mut calls = StageCalls::of(kernels, functions, s);
+            stages.code.push(match &shape.block {
+                None => calls.explicit(),
+                Some(block) => {
+                    stages.blocks = true;
+                    let solved = solved_jacobian(cx, kernels, s);
+                    let trig_first = solved.is_some();
+                    if let Some((function, kernel)) = solved {
+                        stages.variants.push(function);
+                        calls.replace(Method::Jacobian, kernel.call());
+                    }
+                    let factorization = block.factorization?;
+                    block_step(kernels, s, &calls, &units, factorization, trig_first)?
+                }
+            });
+        }
+        Some(stages)
+    }
+
+    /// `straight_stages`, the inherent function that runs them, then the end checks; and the
+    /// Jacobian variants. Parameters no kernel reads are named `_t`, `_report`.
+    fn function(&self, cx: &Context<'_>, kernels: &Kernels, functions: &[&Kernel]) -> TokenStream {
+        let reads = |name: &str| functions.iter().any(|f| f.arguments.contains(&name));
+        let unused = |used: bool, name: &str| {
+            let name = if used {
+                name.to_string()
+            } else {
+                format!("_{name}")
+            };
+            format_ident!("{}", name)
+        };
+        let (t, report) = (unused(reads("t"), "t"), unused(self.blocks, "report"));
+        let trig_len = idx(kernels.sizes.trig);
+        let view = reads("trig").then(|| {
+            quote! {
+                let ::core::option::Option::Some(trig) =
+                    trig_cache.first_chunk_mut::<#trig_len>()
+                else {
+                    return ::core::result::Result::Err(0);
+                };
+            }
+        });
+        let vector = cx.vector_type();
+        let (stages, variants) = (&self.code, &self.variants);
+        quote! {
+            /// The straight kinematic step's stages, in solve order (see
+            /// `Structured::straight_step`).
+            #[allow(clippy::too_many_arguments)]
+            fn straight_stages(
+                &self,
+                #t: f64,
+                q: &mut #vector,
+                qd: &mut #vector,
+                qdd: &mut #vector,
+                trig_cache: &mut [f64],
+                context: &::mechgen_runtime::codegen::StepContext,
+                #report: &mut ::mechgen_runtime::codegen::StepReport,
+            ) -> ::core::result::Result<(), usize> {
+                #view
+                #(#stages)*
+                let end = Self::STAGES.len();
+                context.check_rounding(end, q.as_slice(), &Self::COORDINATE_UNITS)?;
+                context.check_end(end, self, [q, qd, qdd], trig_cache)?;
+                ::core::result::Result::Ok(())
+            }
+            #(#variants)*
+        }
+    }
+}
+
+/// `Structured::straight_step`: the stages, with the guess restored where they fail.
+fn trait_method() -> TokenStream {
+    let vector = quote!(::mechgen_runtime::Vector<Self::Dim>);
+    quote! {
+        fn straight_step(
+            &self,
+            t: f64,
+            q: &mut #vector,
+            qd: &mut #vector,
+            qdd: &mut #vector,
+            trig: &mut [f64],
+            context: &::mechgen_runtime::codegen::StepContext,
+            report: &mut ::mechgen_runtime::codegen::StepReport,
+        ) -> ::core::result::Result<(), usize> {
+            // The sweep that runs where the step fails checks and reads the guess as given.
+            let guess = *q;
+            let result = self.straight_stages(t, q, qd, qdd, trig, context, report);
+            if result.is_err() {
+                *q = guess;
+            }
+            result
+        }
+    }
+}
+
+/// The scene's units, by global index.
+struct Units<'a> {
+    coordinates: &'a [Unit],
+    equations: &'a [Unit],
+}
+
+/// A stage's kernel calls, by method.
+struct StageCalls {
+    calls: Vec<(Method, TokenStream)>,
+}
+
+impl StageCalls {
+    /// The calls of stage `s`'s kernels.
+    fn of(kernels: &Kernels, functions: &[&Kernel], s: usize) -> Self {
+        let calls = kernels
+            .stages
+            .iter()
+            .zip(functions)
+            .filter(|(k, _): &(&StageKernel, _)| k.stage == s)
+            .map(|(k, f)| (k.method, f.call()))
+            .collect();
+        Self { calls }
+    }
+
+    /// Calls `call` for `method` instead of the stage's own kernel.
+    fn replace(&mut self, method: Method, call: TokenStream) {
+        for (m, c) in &mut self.calls {
+            if *m == method {
+                *c = call.clone();
+            }
+        }
+    }
+
+    /// `call;` for the stage's kernel of `method`, nothing without one.
+    fn call(&self, method: Method) -> TokenStream {
+        let call = self.calls.iter().find(|(m, _)| *m == method);
+        call.map(|(_, c)| quote!(#c;)).unwrap_or_default()
+    }
+
+    /// An explicit stage: positions, trig, velocities, accelerations.
+    fn explicit(&self) -> TokenStream {
+        let calls = [
+            Method::Positions,
+            Method::FillTrig,
+            Method::Velocities,
+            Method::Accelerations,
+        ]
+        .map(|m| self.call(m));
+        quote!(#(#calls)*)
+    }
+}
+
+/// Block `s`'s Jacobian kernel reading its own angles' sines and cosines from the trig cache
+/// (filled at the chosen solution before it runs), where it has any: the function and its
+/// call. In the straight step the solution is final when the Jacobian is evaluated, so each
+/// angle's `sin_cos` is computed once, by the trig fill, for the Jacobian and the rates.
+fn solved_jacobian(cx: &Context<'_>, kernels: &Kernels, s: usize) -> Option<(TokenStream, Kernel)> {
+    let k = kernels
+        .stages
+        .iter()
+        .find(|k| k.stage == s && k.method == Method::Jacobian)?;
+    let cached = kernels
+        .trig
+        .reads(cx.arena(), &k.kernel.roots, s, Phase::After);
+    if cached.len() == k.kernel.cached.len() {
+        return None;
+    }
+    let mut solved = k.clone();
+    solved.kernel.cached = cached;
+    let naming = (
+        "solved_jacobian",
+        "the block's residual and Jacobian at its solved positions, its own sines and cosines \
+         read from the cache",
+    );
+    Some(named_kernel_function(cx, kernels, &solved, naming))
+}
+
+/// A block's part of the step: candidates → choice → (trig, when the Jacobian reads it) →
+/// Jacobian and Φ at the choice → scaled factors → checks → (trig) → rates by the static LU.
+/// `None` for a block without a closed form.
+// Kept whole: most of it is the block's template, which reads best in one piece.
+fn block_step(
+    kernels: &Kernels,
+    s: usize,
+    calls: &StageCalls,
+    units: &Units<'_>,
+    factorization: usize,
+    trig_first: bool,
+) -> Option<TokenStream> {
+    let shape = &kernels.shapes[s];
+    let block = shape.block.as_ref()?;
+    if !calls.calls.iter().any(|(m, _)| *m == Method::ClosedForm) {
+        return None;
+    }
+    let n = shape.coordinates.len();
+    let (stage, n_lit, candidates, slots) = (idx(s), idx(n), idx(2 * n), idx(block.slots));
+    let unit = |u: Unit| {
+        let variant = format_ident!("{}", u.name());
+        quote!(::mechgen_runtime::Unit::#variant)
+    };
+    let equation_units = shape.equations.iter().map(|&e| unit(units.equations[e]));
+    let coordinate_units = shape
+        .coordinates
+        .iter()
+        .map(|&c| unit(units.coordinates[c]));
+    let angles = shape
+        .coordinates
+        .iter()
+        .map(|&c| units.coordinates[c] == Unit::Angle);
+    let coordinates: Vec<Literal> = shape.coordinates.iter().map(|&c| idx(c)).collect();
+    let locals: Vec<Literal> = (0..n).map(idx).collect();
+    let pattern = block.pattern.iter().map(|&(i, j)| {
+        let (i, j) = (idx(i), idx(j));
+        quote!((#i, #j))
+    });
+    let pivots = block.pivots.iter().map(|&p| idx(p));
+    let (factor, solve): (Ident, Ident) = (
+        format_ident!("factor_{}", factorization),
+        format_ident!("solve_{}", factorization),
+    );
+    let [closed_form, jacobian, trig, velocity_rhs, acceleration_rhs] = [
+        Method::ClosedForm,
+        Method::Jacobian,
+        Method::FillTrig,
+        Method::VelocityRhs,
+        Method::AccelerationRhs,
+    ]
+    .map(|m| calls.call(m));
+    let (trig_before, trig_after) = if trig_first {
+        (trig, TokenStream::new())
+    } else {
+        (TokenStream::new(), trig)
+    };
+    let scatter = |target: TokenStream| quote!(#(#target[#coordinates] = x[#locals];)*);
+    let (to_q, to_qd, to_qdd) = (
+        scatter(quote!(q)),
+        scatter(quote!(qd)),
+        scatter(quote!(qdd)),
+    );
+    Some(quote! {
+        {
+            let scales = context.scales([#(#equation_units),*], [#(#coordinate_units),*]);
+            let out = &mut [0.0_f64; #candidates];
+            #closed_form
+            let guess = [#(q[#coordinates]),*];
+            let ::core::option::Option::Some(x) =
+                ::mechgen_runtime::codegen::choose(guess, out, [#(#angles),*], &scales)
+            else {
+                return ::core::result::Result::Err(#stage);
+            };
+            #to_q
+            #trig_before
+            let (phi, values) = (&mut [0.0_f64; #n_lit], &mut [0.0_f64; #slots]);
+            #jacobian
+            let (tiny, norm1) =
+                context.scale_jacobian(#stage, values, &[#(#pattern),*], &scales)?;
+            if Self::#factor(values, tiny, context.limit()).is_err() {
+                return ::core::result::Result::Err(#stage);
+            }
+            let values = &*values;
+            let solve = |x: &mut [f64; #n_lit]| Self::#solve(values, x);
+            context.accept(#stage, phi, &x, &scales, &[#(values[#pivots]),*], norm1, solve, report)?;
+            #trig_after
+            let out = &mut [0.0_f64; #n_lit];
+            #velocity_rhs
+            let x = context.rates(#stage, out, &scales, solve)?;
+            #to_qd
+            #acceleration_rhs
+            let x = context.rates(#stage, out, &scales, solve)?;
+            #to_qdd
+        }
+    })
+}

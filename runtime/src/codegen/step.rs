@@ -1,0 +1,245 @@
+//! What a scene's straight kinematic step ([`crate::Structured::straight_step`]) calls: the
+//! solver's settings it checks against ([`StepContext`]), what it reports back
+//! ([`StepReport`]), and the safeguards of a closed-form block, each the same rule the
+//! stage sweep applies to that block's Newton start.
+//!
+//! The generated step runs every stage in the sweep's order with the scene's kernels called
+//! directly. A block takes its closed-form solution nearest the guess ([`choose`], the rule
+//! of the sweep's closed-form start), its unit-scaled Jacobian is factored with the static
+//! pivots under the same thresholds ([`StepContext::scale_jacobian`]), and the solution must
+//! pass what Newton's first iteration from it would check ([`StepContext::accept`]): a
+//! residual within the tolerances, a Newton correction within the step tolerance (so the
+//! sweep would stop there), and the condition limit; the whole solution passes the sweep's end
+//! checks ([`StepContext::check_rounding`], [`StepContext::check_end`]). Any check that fails
+//! makes the step return `Err(stage)`; the solver then runs the stage sweep from the original guess, whose
+//! answers and errors are unchanged.
+
+use nalgebra::DefaultAllocator;
+
+use crate::acceptance::COEFFICIENT_ROOM;
+use crate::block::{SCALE_FLOOR, bounded_condition, exact_inverse_norm};
+use crate::block_signs::block_code;
+use crate::finite::all_finite;
+use crate::mechanism::{Storage, Unit, Vector};
+use crate::position::nearest;
+use crate::step::{BlockScales, StepContext, StepReport};
+use crate::structure::Structured;
+
+impl StepContext {
+    /// The sweep's end checks at the step's solution: every position and rate finite, every
+    /// branch invariant of `m` positive (read from the filled trig cache `trig`).
+    ///
+    /// # Errors
+    /// `stage` (the stage count) where one fails: the sweep reports it.
+    pub fn check_end<M: Structured>(
+        &self,
+        stage: usize,
+        m: &M,
+        [q, qd, qdd]: [&Vector<M::Dim>; 3],
+        trig: &[f64],
+    ) -> Result<(), usize>
+    where
+        DefaultAllocator: Storage<M::Dim>,
+    {
+        let finite = [q, qd, qdd].iter().all(|v| all_finite(v.as_slice()));
+        // NaN is not positive either.
+        let branches = (0..m.branch_count()).all(|b| m.branch(b, q, trig) > 0.0);
+        if finite && branches {
+            Ok(())
+        } else {
+            Err(stage)
+        }
+    }
+
+    /// The unit scales of a block with these equation and coordinate units.
+    #[inline]
+    pub fn scales<const N: usize>(
+        &self,
+        equations: [Unit; N],
+        coordinates: [Unit; N],
+    ) -> BlockScales<N> {
+        BlockScales {
+            rows: equations.map(|u| self.length.inverse_of(u)),
+            cols: coordinates.map(|u| self.length.of(u)),
+            inverse_cols: coordinates.map(|u| self.length.inverse_of(u)),
+        }
+    }
+
+    /// Scales the block Jacobian's `values` (entries at `pattern`, (row, column)) to
+    /// `S = D_r J D_c` and returns the static pivots' `tiny` (as the sweep's factorisation
+    /// computes it) and `‖S‖₁`.
+    ///
+    /// # Errors
+    /// `stage` for a non-finite entry.
+    #[inline]
+    pub fn scale_jacobian<const N: usize, const S: usize>(
+        &self,
+        stage: usize,
+        values: &mut [f64; S],
+        pattern: &[(usize, usize); S],
+        scales: &BlockScales<N>,
+    ) -> Result<(f64, f64), usize> {
+        let (mut largest, mut sums, mut finite) = (0.0_f64, [0.0; N], true);
+        for (value, &(i, j)) in values.iter_mut().zip(pattern) {
+            *value *= scales.rows[i] * scales.cols[j];
+            let magnitude = value.abs();
+            // NaN fails this test (and `max` would drop it).
+            finite &= magnitude <= f64::MAX;
+            largest = largest.max(magnitude);
+            sums[j] += magnitude;
+        }
+        if !finite {
+            return Err(stage);
+        }
+        let tiny = self.pivot_tolerance * N as f64 * largest.max(SCALE_FLOOR);
+        Ok((tiny, sums.iter().fold(0.0_f64, |m, &s| m.max(s))))
+    }
+
+    /// The static pivots' multiplier limit.
+    #[inline]
+    pub fn limit(&self) -> f64 {
+        self.limit
+    }
+
+    /// The checks at a block's closed-form solution `chosen`, whose unscaled residual is `phi`
+    /// and whose scaled Jacobian has static factors with pivots `pivots` (values of the
+    /// factored slots) and norm `norm1`; `solve` is `x ← S⁻¹ x` with those factors. Passes
+    /// where Newton from `chosen` would stop at its first iteration (residual within
+    /// `residual_tolerance` and the acceptance tolerance, correction within
+    /// `step_tolerance`), and the condition estimate is within `max_condition`; records the
+    /// block in `report`.
+    ///
+    /// # Errors
+    /// `stage` when a check fails.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    pub fn accept<const N: usize>(
+        &self,
+        stage: usize,
+        phi: &[f64; N],
+        chosen: &[f64; N],
+        scales: &BlockScales<N>,
+        pivots: &[f64],
+        norm1: f64,
+        mut solve: impl FnMut(&mut [f64; N]),
+        report: &mut StepReport,
+    ) -> Result<(), usize> {
+        let magnitude = scaled_max(chosen, &scales.inverse_cols).max(1.0);
+        let mut step = [0.0; N];
+        for ((s, &p), &r) in step.iter_mut().zip(phi).zip(&scales.rows) {
+            *s = p * r;
+        }
+        let residual = step.iter().fold(0.0_f64, |m, s| larger(m, s.abs()));
+        let small = residual <= self.residual_tolerance * magnitude && residual <= self.acceptance;
+        // The Newton correction S⁻¹ D_r Φ is D_c⁻¹ Δq: in scene lengths and radians already.
+        solve(&mut step);
+        let length = step.iter().fold(0.0_f64, |m, s| larger(m, s.abs()));
+        if !(small && length <= self.step_tolerance * magnitude) {
+            return Err(stage);
+        }
+        let condition = if self.estimate_condition {
+            let mut x = [0.0; N];
+            let inverse_norm = exact_inverse_norm(&mut x, |x| {
+                if let Some(x) = x.first_chunk_mut::<N>() {
+                    solve(x);
+                }
+            });
+            let condition = bounded_condition(inverse_norm, norm1);
+            if condition.is_nan() || condition > self.max_condition {
+                return Err(stage);
+            }
+            larger(report.condition, condition)
+        } else {
+            f64::NAN
+        };
+        let negative = pivots.iter().fold(false, |n, &p| n ^ (p < 0.0));
+        if negative {
+            report.orientation = -report.orientation;
+            report.block_signs ^= block_code(stage);
+        }
+        report.condition = condition;
+        report.residual = report
+            .residual
+            .max(phi.iter().fold(0.0_f64, |m, p| m.max(p.abs())));
+        report.blocks += 1;
+        Ok(())
+    }
+
+    /// A block's rates from its right-hand side `rhs` (unscaled, row order): `J⁻¹ rhs`, with
+    /// `solve` (`x ← S⁻¹ x`) of the block's factors.
+    ///
+    /// # Errors
+    /// `stage` for a non-finite right-hand side or rate.
+    #[inline]
+    pub fn rates<const N: usize>(
+        &self,
+        stage: usize,
+        rhs: &[f64; N],
+        scales: &BlockScales<N>,
+        solve: impl FnOnce(&mut [f64; N]),
+    ) -> Result<[f64; N], usize> {
+        let mut x = [0.0; N];
+        for ((x, &b), &r) in x.iter_mut().zip(rhs).zip(&scales.rows) {
+            *x = b * r;
+        }
+        solve(&mut x);
+        for (x, &c) in x.iter_mut().zip(&scales.cols) {
+            *x *= c;
+        }
+        if x.iter().all(|x| x.is_finite()) {
+            Ok(x)
+        } else {
+            Err(stage)
+        }
+    }
+
+    /// Whether explicit assignments can be accepted unevaluated at `q` (the sweep's rounding
+    /// bound, see [`crate::acceptance`]): every scaled coordinate below it. Above, the sweep's
+    /// evaluation of the explicit residuals decides.
+    ///
+    /// # Errors
+    /// `stage` above the bound (or for a non-finite coordinate).
+    #[inline]
+    pub fn check_rounding(&self, stage: usize, q: &[f64], units: &[Unit]) -> Result<(), usize> {
+        let bound = self.acceptance / (f64::EPSILON * COEFFICIENT_ROOM);
+        let magnitude = q.iter().zip(units).fold(0.0_f64, |m, (&x, &u)| {
+            larger(m, (x * self.length.inverse_of(u)).abs())
+        });
+        if magnitude <= bound {
+            Ok(())
+        } else {
+            Err(stage)
+        }
+    }
+}
+
+/// The closed-form solution of a block at `guess` that the sweep would start Newton from:
+/// of the two `candidates` (candidate-major), the nearest, with its angles (`angles[j]`) moved
+/// to the guess's turn; `None` where the sweep would start from the guess itself (near a
+/// toggle, a guess between the solutions, a loop that cannot close, or `candidates` not
+/// `2 N` long).
+#[inline]
+pub fn choose<const N: usize, const C: usize>(
+    guess: [f64; N],
+    candidates: &[f64; C],
+    angles: [bool; N],
+    scales: &BlockScales<N>,
+) -> Option<[f64; N]> {
+    let (first, second) = candidates.split_first_chunk::<N>()?;
+    let second = second.first_chunk::<N>().filter(|_| C == 2 * N)?;
+    let mut candidates = [*first, *second];
+    let nearest = nearest(&guess, &mut candidates, &angles, &scales.inverse_cols)?;
+    Some(candidates[nearest])
+}
+
+/// `max |v_j c_j|`, NaN winning.
+fn scaled_max<const N: usize>(v: &[f64; N], c: &[f64; N]) -> f64 {
+    v.iter()
+        .zip(c)
+        .fold(0.0, |m, (x, c)| larger(m, (x * c).abs()))
+}
+
+/// The larger of two values, NaN winning.
+fn larger(a: f64, b: f64) -> f64 {
+    if b > a || b.is_nan() { b } else { a }
+}
