@@ -34,3 +34,22 @@ pub fn example_scene(file: &str) -> mechgen_interp::Interpreted {
 #[doc = include_str!("../../README.md")]
 #[cfg(doctest)]
 pub struct ReadmeDoctests;
+
+/// Sample times from 0 to 1.5 `toggle` in steps of `typical` times the `fractions` (cycled,
+/// all positive), with one exactly at the toggle when `land`: how the toggle tests step a
+/// mechanism through a singular configuration at random step lengths.
+pub fn toggle_times(toggle: f64, typical: f64, fractions: &[f64], land: bool) -> Vec<f64> {
+    let mut times = Vec::new();
+    let mut t = 0.0;
+    for f in fractions.iter().cycle() {
+        t += typical * f;
+        if land && t > toggle && times.last().is_none_or(|&last| last < toggle) {
+            times.push(toggle);
+        }
+        times.push(t);
+        if t > 1.5 * toggle {
+            break;
+        }
+    }
+    times
+}

@@ -11,6 +11,7 @@ use mechgen_runtime::{
     Mechanism, Simulation, SolveError, Solver, State, Structured, Unit, mechanism,
     nalgebra::DefaultAllocator,
 };
+use mechgen_tests::toggle_times;
 use proptest::prelude::*;
 
 mechanism! {
@@ -86,24 +87,6 @@ where
     (solved, None)
 }
 
-/// Sample times from 0 past `toggle`: steps of random lengths (fractions of `typical`), with
-/// one sample exactly at the toggle when `land`.
-fn times(toggle: f64, typical: f64, fractions: &[f64], land: bool) -> Vec<f64> {
-    let mut times = Vec::new();
-    let mut t = 0.0;
-    for f in fractions.iter().cycle() {
-        t += typical * f;
-        if land && t > toggle && times.last().is_none_or(|&last| last < toggle) {
-            times.push(toggle);
-        }
-        times.push(t);
-        if t > 1.5 * toggle {
-            break;
-        }
-    }
-    times
-}
-
 /// The run ended with `Singular` within one step of the toggle, and no state was returned at
 /// the toggle or past it.
 fn assert_caught(toggle: f64, times: &[f64], solved: &[f64], error: Option<SolveError>) {
@@ -143,7 +126,7 @@ proptest! {
         land in any::<bool>(),
     ) {
         let toggle = slider_crank_toggle(omega);
-        let times = times(toggle, toggle / per_quarter as f64, &fractions, land);
+        let times = toggle_times(toggle, toggle / per_quarter as f64, &fractions, land);
         let (solved, error) = run(SliderCrank { r, l: r, omega }, &times);
         assert_caught(toggle, &times, &solved, error);
         let (solved, error) = run(FreeSliderCrank { r, l: r, omega }, &times);
@@ -161,7 +144,7 @@ proptest! {
     ) {
         // From crank angle 0.5 to the line-up at π.
         let toggle = (core::f64::consts::PI - 0.5) / omega;
-        let times = times(toggle, toggle / per_half as f64, &fractions, land);
+        let times = toggle_times(toggle, toggle / per_half as f64, &fractions, land);
         let scene = ChangePointFourBar {
             crank_length: crank,
             frame_length: crank * ratio,
@@ -185,7 +168,7 @@ proptest! {
         // of it, and exactly at it when `land`.
         let l = r * (1.0 + 10_f64.powf(excess));
         let near = slider_crank_toggle(1.0);
-        let times = times(near, near / per_quarter as f64, &fractions, land);
+        let times = toggle_times(near, near / per_quarter as f64, &fractions, land);
         let exact = closed_form::SliderCrank { crank: r, rod: l, omega: 1.0 };
         let mut simulation =
             Simulation::new(Solver::new(SliderCrank { r, l, ..SliderCrank::default() }), 0.0)
@@ -222,7 +205,7 @@ proptest! {
         // reach (a step over the whole range can still land on its far side: see the module
         // docs of `crossing`).
         let limit = (l / r).asin();
-        let mut times = times(limit, limit / per_quarter as f64, &fractions, false);
+        let mut times = toggle_times(limit, limit / per_quarter as f64, &fractions, false);
         times.retain(|&t| t < limit);
         times.push(core::f64::consts::FRAC_PI_2);
         let scene = SliderCrank { r, l, ..SliderCrank::default() };

@@ -9,6 +9,7 @@ use core::f64::consts::FRAC_PI_2;
 
 use mechgen_runtime::nalgebra::Const;
 use mechgen_runtime::{Accelerations, Simulation, SolveError, Solver, Structured};
+use mechgen_tests::toggle_times;
 use proptest::prelude::*;
 
 use super::compare::{
@@ -278,24 +279,6 @@ where
     }
 }
 
-/// Sample times from 0 to 1.5 `toggle` in steps of `typical` times the `fractions` (cycled),
-/// with one exactly at the toggle when `land`.
-fn times(toggle: f64, typical: f64, fractions: &[f64], land: bool) -> Vec<f64> {
-    let mut times = Vec::new();
-    let mut t = 0.0;
-    for f in fractions.iter().cycle() {
-        t += typical * f;
-        if land && t > toggle && times.last().is_none_or(|&last| last < toggle) {
-            times.push(toggle);
-        }
-        times.push(t);
-        if t > 1.5 * toggle {
-            return times;
-        }
-    }
-    unreachable!("the fractions are positive")
-}
-
 proptest! {
     // Failures are not persisted: proptest finds no crate root beside a submodule's file.
     #![proptest_config(ProptestConfig {
@@ -313,7 +296,7 @@ proptest! {
     ) {
         let scene = PushedSlider::default();
         let dead_centre = (scene.r + scene.l - scene.start) / scene.speed;
-        let times = times(dead_centre, dead_centre / steps as f64, &fractions, land);
+        let times = toggle_times(dead_centre, dead_centre / steps as f64, &fractions, land);
         stops_alike("pushed slider", &scene, scene.r + scene.l, dead_centre, &times);
     }
 
@@ -341,7 +324,7 @@ proptest! {
             rocker_guess: 0.5,
         };
         let change_point = (core::f64::consts::PI - 0.5) / omega;
-        let times = times(change_point, change_point / steps as f64, &fractions, land);
+        let times = toggle_times(change_point, change_point / steps as f64, &fractions, land);
         stops_alike("change-point four-bar", &scene, frame + crank, change_point, &times);
     }
 }
