@@ -23,8 +23,7 @@ use mechgen_runtime::{Accelerations, Mechanism, Structured, Vector};
 use proptest::prelude::*;
 
 use compare::{
-    Solved, assert_same_turns, assert_within, between, from_exact, guess_near, run,
-    run_interpreted, solve,
+    Solved, apart, assert_same_turns, assert_within, guess_near, run, run_interpreted, solve,
 };
 use exact::Exact;
 use scenes::{
@@ -64,12 +63,12 @@ fn check_instant<M, const N: usize>(
     let what = format!("{what}, t = {t}");
     assert_within(
         &format!("{what}, closed forms vs exact"),
-        from_exact(scene, length, &closed, want),
+        apart(scene, length, &closed, want),
         ROUND_OFF,
     );
     assert_within(
         &format!("{what}, closed forms vs Newton"),
-        between(scene, length, &closed, &newton),
+        apart(scene, length, &closed, &newton),
         ROUND_OFF,
     );
     assert_same_turns(&what, scene, &closed.q, &newton.q);
@@ -353,7 +352,7 @@ proptest! {
             prop_assert_eq!(closed.closed_forms, 1, "the dyad alone, t = {}", t);
             prop_assert_eq!(newton.closed_forms, 0);
             let what = format!("six-bar, t = {t}");
-            assert_within(&what, between(&scene, length, &closed, &newton), ROUND_OFF);
+            assert_within(&what, apart(&scene, length, &closed, &newton), ROUND_OFF);
             let phi = residual(&scene, length, &closed.q, t);
             prop_assert!(phi <= 1e-13, "Φ = {:e} scene lengths at t = {}", phi, t);
         }
@@ -381,7 +380,7 @@ fn runs_agree<M, const N: usize>(
         assert_eq!(off.closed_forms, 0, "{what}, step {k}");
         assert_within(
             &format!("{what}, step {k}"),
-            between(scene, length, on, off),
+            apart(scene, length, on, off),
             ROUND_OFF,
         );
         check(t, on);
@@ -403,7 +402,7 @@ fn runs_agree_with_exact<M, const N: usize>(
         assert_eq!(state.evaluations, 1, "{what}, t = {t}");
         assert_within(
             &format!("{what}, t = {t}"),
-            from_exact(scene, length, state, &exact::at(&motion, t)),
+            apart(scene, length, state, &exact::at(&motion, t)),
             ROUND_OFF,
         );
     });
@@ -485,7 +484,7 @@ fn interpreted_agrees<M, const N: usize>(
         assert_eq!(g.closed_forms, i.closed_forms, "{what}, step {k}");
         assert_within(
             &format!("{what}, step {k}"),
-            between(scene, length, i, g),
+            apart(scene, length, i, g),
             ROUND_OFF,
         );
     }

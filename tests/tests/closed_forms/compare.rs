@@ -96,7 +96,7 @@ pub fn assert_same_error<T: core::fmt::Debug>(
 
 /// The largest differences of q (absolute), q̇ and q̈ (relative to the largest magnitude of
 /// `want`'s), lengths divided by `length` and angles compared modulo whole turns.
-pub fn differences<M: Mechanism<Dim = Const<N>>, const N: usize>(
+fn differences<M: Mechanism<Dim = Const<N>>, const N: usize>(
     scene: &M,
     length: f64,
     got: [&[f64; N]; 3],
@@ -126,34 +126,31 @@ pub fn differences<M: Mechanism<Dim = Const<N>>, const N: usize>(
     worst
 }
 
-/// [`differences`] of a solved state from the exact motion.
-pub fn from_exact<M: Mechanism<Dim = Const<N>>, const N: usize>(
-    scene: &M,
-    length: f64,
-    got: &Solved<N>,
-    want: &Exact<N>,
-) -> [f64; 3] {
-    differences(
-        scene,
-        length,
-        [&got.q, &got.qd, &got.qdd],
-        [&want.q, &want.qd, &want.qdd],
-    )
+/// q, q̇ and q̈ of an instant, solved or exact.
+pub trait Levels<const N: usize> {
+    fn levels(&self) -> [&[f64; N]; 3];
 }
 
-/// [`differences`] between two solved states.
-pub fn between<M: Mechanism<Dim = Const<N>>, const N: usize>(
+impl<const N: usize> Levels<N> for Solved<N> {
+    fn levels(&self) -> [&[f64; N]; 3] {
+        [&self.q, &self.qd, &self.qdd]
+    }
+}
+
+impl<const N: usize> Levels<N> for Exact<N> {
+    fn levels(&self) -> [&[f64; N]; 3] {
+        [&self.q, &self.qd, &self.qdd]
+    }
+}
+
+/// [`differences`] between two instants (solved, or the exact motion).
+pub fn apart<M: Mechanism<Dim = Const<N>>, const N: usize>(
     scene: &M,
     length: f64,
-    got: &Solved<N>,
-    want: &Solved<N>,
+    got: &impl Levels<N>,
+    want: &impl Levels<N>,
 ) -> [f64; 3] {
-    differences(
-        scene,
-        length,
-        [&got.q, &got.qd, &got.qdd],
-        [&want.q, &want.qd, &want.qdd],
-    )
+    differences(scene, length, got.levels(), want.levels())
 }
 
 /// Each difference within its tolerance.

@@ -12,9 +12,7 @@ use mechgen_runtime::{Accelerations, Simulation, SolveError, Solver, Structured}
 use mechgen_tests::toggle_times;
 use proptest::prelude::*;
 
-use super::compare::{
-    Solved, assert_same_error, assert_within, between, from_exact, options, solve,
-};
+use super::compare::{Solved, apart, assert_same_error, assert_within, options, solve};
 use super::exact::{self, Exact};
 use super::scenes::{FourBar, OffsetSlider, PushedSlider};
 
@@ -58,13 +56,13 @@ where
     };
     assert_within(
         &format!("{what}: closed forms vs Newton"),
-        between(scene, length, &a, &b),
+        apart(scene, length, &a, &b),
         NEAR_TOLERANCE,
     );
     if let Some(want) = want {
         assert_within(
             &format!("{what}: closed forms vs exact"),
-            from_exact(scene, length, &a, want),
+            apart(scene, length, &a, want),
             NEAR_TOLERANCE,
         );
     }
@@ -95,7 +93,7 @@ fn near<M, const N: usize>(
                 assert_eq!((closed.closed_forms, closed.evaluations), (1, 1), "{what}");
                 assert_within(
                     &what,
-                    from_exact(&scene, length, closed, &want),
+                    apart(&scene, length, closed, &want),
                     STARTED_TOLERANCE,
                 );
             }
@@ -119,6 +117,35 @@ where
     let closed: Result<Solved<N>, SolveError> = solve(scene, true, t, guess);
     let newton = solve(scene, false, t, guess);
     assert_same_error(what, &closed, &newton);
+}
+
+/// A scene driven to its `limit` (time) along the exact `motion` of one branch: [`near`] it
+/// from a guess 0.05 before, [`at`] it, and [`beyond`] it, just and by [`BEYOND`].
+fn to_the_limit<M, const N: usize>(
+    what: &str,
+    scene: &M,
+    length: f64,
+    limit: f64,
+    motion: impl Fn(exact::Dual) -> [exact::Dual; N],
+) where
+    M: Structured<Dim = Const<N>> + Accelerations + Clone,
+{
+    let guess = exact::at(&motion, limit - 0.05).q;
+    near(what, length, &guess, |distance| {
+        (
+            scene.clone(),
+            limit - distance,
+            exact::at(&motion, limit - distance),
+        )
+    });
+    at(&format!("{what}, at"), scene, length, limit, &guess);
+    beyond(
+        &format!("{what}, just beyond"),
+        scene,
+        limit + NEAR[2],
+        &guess,
+    );
+    beyond(&format!("{what}, beyond"), scene, limit + BEYOND, &guess);
 }
 
 proptest! {
@@ -179,14 +206,7 @@ proptest! {
         let limit = ((a * a + d * d - (b + c) * (b + c)) / (2.0 * a * d)).acos();
         for sign in [1.0, -1.0] {
             let what = format!("{scene:?}, limit {limit}, branch {sign}");
-            let motion = exact::four_bar(&scene, sign);
-            let guess = exact::at(&motion, limit - 0.05).q;
-            near(&what, length, &guess, |distance| {
-                (scene, limit - distance, exact::at(&motion, limit - distance))
-            });
-            at(&format!("{what}, at"), &scene, length, limit, &guess);
-            beyond(&format!("{what}, just beyond"), &scene, limit + NEAR[2], &guess);
-            beyond(&format!("{what}, beyond"), &scene, limit + BEYOND, &guess);
+            to_the_limit(&what, &scene, length, limit, exact::four_bar(&scene, sign));
         }
     }
 
@@ -206,14 +226,7 @@ proptest! {
         let limit = ((e + l) / r).asin();
         for side in [1.0, -1.0] {
             let what = format!("{scene:?}, limit {limit}, side {side}");
-            let motion = exact::offset_slider(&scene, side);
-            let guess = exact::at(&motion, limit - 0.05).q;
-            near(&what, length, &guess, |distance| {
-                (scene, limit - distance, exact::at(&motion, limit - distance))
-            });
-            at(&format!("{what}, at"), &scene, length, limit, &guess);
-            beyond(&format!("{what}, just beyond"), &scene, limit + NEAR[2], &guess);
-            beyond(&format!("{what}, beyond"), &scene, limit + BEYOND, &guess);
+            to_the_limit(&what, &scene, length, limit, exact::offset_slider(&scene, side));
         }
     }
 }
