@@ -22,4 +22,4 @@ pub use crate::structure::{Block, Pattern, Stage};
 #[cfg(feature = "alloc")]
 pub use crate::workspace::VecBuffers;
 pub use crate::workspace::{Buffers, Parts, Workspace};
-pub use step::choose;
+pub use step::Choice;

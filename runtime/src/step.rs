@@ -19,6 +19,9 @@ pub struct StepContext {
     pub(crate) limit: f64,
     pub(crate) max_condition: f64,
     pub(crate) estimate_condition: bool,
+    /// Which closed-form candidate each block tries first: the last straight step's choices
+    /// (see [`StepReport::choices`]).
+    pub(crate) choices: u64,
 }
 
 /// What a straight step found, for the solve's [`crate::Convergence`].
@@ -29,6 +32,9 @@ pub struct StepReport {
     pub(crate) condition: f64,
     pub(crate) orientation: i8,
     pub(crate) block_signs: u64,
+    /// Bit `stage % 64` set where a block took its second closed-form candidate: only an
+    /// order of trial (a shared bit costs an `atan2`, never a different answer).
+    pub(crate) choices: u64,
 }
 
 /// A block's unit scales: `D_r` per equation, `D_c` and `D_c⁻¹` per coordinate.
@@ -40,8 +46,9 @@ pub struct BlockScales<const N: usize> {
 }
 
 impl StepContext {
-    /// The settings of `options` at the solve's length scale.
-    pub(crate) fn new(options: &SolverOptions, length: LengthScale) -> Self {
+    /// The settings of `options` at the solve's length scale, with the blocks trying first
+    /// the closed-form candidates of `choices`.
+    pub(crate) fn new(options: &SolverOptions, length: LengthScale, choices: u64) -> Self {
         Self {
             length,
             residual_tolerance: options.residual_tolerance,
@@ -51,6 +58,7 @@ impl StepContext {
             limit: 1.0 / options.static_pivot_threshold,
             max_condition: options.max_condition,
             estimate_condition: options.estimate_condition,
+            choices,
         }
     }
 }
@@ -64,6 +72,7 @@ impl StepReport {
             condition: if estimate_condition { 1.0 } else { f64::NAN },
             orientation: 1,
             block_signs: 0,
+            choices: 0,
         }
     }
 }

@@ -162,11 +162,13 @@ where
     );
 
     /// Writes a block's two solutions in closed form, where the generator found them (a loop
-    /// that closes by a circle–line or circle–circle intersection): the block's coordinates in
-    /// local column order, candidate-major, into `out` (twice the block's length), from the
-    /// earlier stages' positions in `q`. NaN where the loop cannot close. An angle may differ
-    /// from the solution wanted by whole turns. Blocks without a closed form leave `out` as it
-    /// is (the solver fills it with NaN first): the default, for scenes without any.
+    /// that closes by a circle–line or circle–circle intersection), from the earlier stages'
+    /// positions in `q`, into `out` (four times the block's length): candidate-major, and per
+    /// coordinate of the block (local column order) two numbers, a length's value and 0, or an
+    /// angle's cosine and sine (the intersection's unit vector: the solver takes the angle by
+    /// `atan2`, and the straight step fills the trig cache with them). NaN where the loop
+    /// cannot close. Blocks without a closed form leave `out` as it is (the solver fills it
+    /// with NaN first): the default, for scenes without any.
     fn closed_form(
         &self,
         _stage: usize,

@@ -18,6 +18,11 @@ pub trait Workspace {
     /// head the solver fills with the dependent equations, and the undetermined coordinates'
     /// buffer.
     fn diagnosis(&self) -> (&[usize], &[usize]);
+
+    /// The trig cache alone ([`Parts::trig`]), for the straight step, which needs nothing else.
+    fn trig(&mut self) -> &mut [f64] {
+        self.parts().trig
+    }
 }
 
 /// The buffers of a [`Workspace`], each at least as long as the scene's largest block needs
@@ -226,6 +231,10 @@ impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: us
     fn diagnosis(&self) -> (&[usize], &[usize]) {
         (&self.indices[1], &self.undetermined)
     }
+
+    fn trig(&mut self) -> &mut [f64] {
+        &mut self.trig
+    }
 }
 
 /// Heap storage for scenes whose sizes are known only at run time (the interpreter).
@@ -295,6 +304,10 @@ impl Workspace for VecBuffers {
 
     fn diagnosis(&self) -> (&[usize], &[usize]) {
         (&self.indices[1], &self.undetermined)
+    }
+
+    fn trig(&mut self) -> &mut [f64] {
+        &mut self.trig
     }
 }
 

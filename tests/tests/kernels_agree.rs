@@ -48,7 +48,7 @@ where
             m.assign_accelerations(s, &q, trig, &qd, &mut w, t);
             out.push((tag("accelerations"), w.as_slice().to_vec()));
             for len in [8, 1] {
-                let mut candidates = vec![SENTINEL; 2 * len];
+                let mut candidates = vec![SENTINEL; 4 * len];
                 m.closed_form(s, &q, trig, t, &mut candidates);
                 out.push((tag(&format!("closed form ({len})")), candidates));
                 let (mut phi, mut values) = (vec![SENTINEL; len], vec![SENTINEL; 3 * len]);

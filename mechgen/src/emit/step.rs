@@ -228,8 +228,9 @@ fn solved_jacobian(cx: &Context<'_>, kernels: &Kernels, s: usize) -> Option<(Tok
     Some(named_kernel_function(cx, kernels, &solved, naming))
 }
 
-/// A block's part of the step: candidates → choice → (trig, when the Jacobian reads it) →
-/// Jacobian and Φ at the choice → scaled factors → checks → (trig) → rates by the static LU.
+/// A block's part of the step: candidates → choice → (trig from the choice's unit vectors,
+/// when the Jacobian reads it) → Jacobian and Φ at the choice → scaled factors → checks →
+/// (trig) → rates by the static LU.
 /// `None` for a block without a closed form.
 // Kept whole: most of it is the block's template, which reads best in one piece.
 fn block_step(
@@ -246,7 +247,7 @@ fn block_step(
         return None;
     }
     let n = shape.coordinates.len();
-    let (stage, n_lit, candidates, slots) = (idx(s), idx(n), idx(2 * n), idx(block.slots));
+    let (stage, n_lit, candidates, slots) = (idx(s), idx(n), idx(4 * n), idx(block.slots));
     let unit = |u: Unit| {
         let variant = format_ident!("{}", u.name());
         quote!(::mechgen_runtime::Unit::#variant)
@@ -280,7 +281,7 @@ fn block_step(
     ]
     .map(|m| calls.call(m));
     let (trig_before, trig_after) = if trig_first {
-        (trig, TokenStream::new())
+        (trig_from_units(kernels, s, trig), TokenStream::new())
     } else {
         (TokenStream::new(), trig)
     };
@@ -296,11 +297,12 @@ fn block_step(
             let out = &mut [0.0_f64; #candidates];
             #closed_form
             let guess = [#(q[#coordinates]),*];
-            let ::core::option::Option::Some(x) =
-                ::mechgen_runtime::codegen::choose(guess, out, [#(#angles),*], &scales)
+            let ::core::option::Option::Some(choice) =
+                context.choose(#stage, guess, out, [#(#angles),*], &scales, report)
             else {
                 return ::core::result::Result::Err(#stage);
             };
+            let x = choice.values;
             #to_q
             #trig_before
             let (phi, values) = (&mut [0.0_f64; #n_lit], &mut [0.0_f64; #slots]);
@@ -323,4 +325,32 @@ fn block_step(
             #to_qdd
         }
     })
+}
+
+/// Block `s`'s trig fill from its chosen solution's unit vectors (the intersection gave each
+/// angle's cosine and sine), with `fill` (the stage's `sin_cos` kernel) where they are not on
+/// the unit circle to rounding.
+fn trig_from_units(kernels: &Kernels, s: usize, fill: TokenStream) -> TokenStream {
+    let coordinates = &kernels.shapes[s].coordinates;
+    let writes: Option<Vec<TokenStream>> = kernels
+        .trig
+        .fills(s)
+        .map(|m| {
+            let j = coordinates
+                .iter()
+                .position(|&c| c == kernels.trig.angles[m])?;
+            let (sin, cos, j) = (idx(2 * m), idx(2 * m + 1), idx(j));
+            Some(quote!(trig[#sin] = units[#j][1]; trig[#cos] = units[#j][0];))
+        })
+        .collect();
+    let Some(writes) = writes.filter(|w| !w.is_empty()) else {
+        return fill;
+    };
+    quote! {
+        if let ::core::option::Option::Some(units) = choice.units() {
+            #(#writes)*
+        } else {
+            #fill
+        }
+    }
 }

@@ -16,16 +16,18 @@
 //! - [`ClosedKind::Linear`]: one length with a known coefficient.
 //!
 //! The roots are the intersection of the unit circle with the line `a x + b y + c = 0`:
-//! `(x, y)± = (−c (a, b) ± √(a² + b² − c²) (−b, a)) / (a² + b²)`, each angle then `atan2(y, x)`:
-//! no trigonometry of the unknowns, one square root per group. A negative discriminant (the
-//! loop cannot close) makes both candidates NaN. The runtime starts the block's Newton
+//! `(x, y)± = (−c (a, b) ± √(a² + b² − c²) (−b, a)) / (a² + b²)`: no trigonometry of the
+//! unknowns, one square root per group. Each angle is written as its unit vector
+//! `(cos θ, sin θ)`: the runtime takes `atan2` of the one it keeps, and the straight step fills
+//! the trig cache with it in place of a `sin_cos`. A negative discriminant (the loop cannot
+//! close) makes both candidates NaN. The runtime starts the block's Newton
 //! iteration from the candidate nearest its guess and Newton verifies it (one evaluation, which
 //! the rates need anyway), so the closed form never lowers accuracy: near a toggle, where the
 //! root is ill-conditioned, Newton refines it; where there is none, Newton runs as before.
 
 use std::collections::HashMap;
 
-use crate::expr::{Arena, Func, Func2, Id, Node, Var};
+use crate::expr::{Arena, Func, Id, Node, Var};
 
 /// What kind of closed form a block has (named in `mechgen check --stats`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -55,8 +57,9 @@ pub struct ClosedForm {
     /// Which intersection it is.
     pub kind: ClosedKind,
     /// Two candidate solutions of the block's coordinates (in the block's column order),
-    /// candidate-major: `[c₀ of the first, c₁ of the first, c₀ of the second, …]`. A group with
-    /// one solution lists it twice.
+    /// candidate-major, two entries per coordinate: a length's value and 0, or an angle's
+    /// cosine and sine (`[c₀ of the first (2), c₁ of the first (2), c₀ of the second, …]`). A
+    /// group with one solution lists it twice.
     pub candidates: Vec<Id>,
 }
 
@@ -259,17 +262,23 @@ fn circle_line(arena: &mut Arena, a: Id, b: Id, c: Id) -> [(Id, Id); 2] {
     [point(arena, true), point(arena, false)]
 }
 
-/// `atan2(y, x)`.
-fn angle(arena: &mut Arena, (x, y): (Id, Id)) -> Id {
-    arena.call2(Func2::Atan2, y, x)
+/// A length's two entries in the candidates: its value and 0.
+fn length(arena: &Arena, value: Id) -> [Id; 2] {
+    [value, arena.zero()]
+}
+
+/// An angle's two entries in the candidates: its unit vector.
+fn angle((cos, sin): (Id, Id)) -> [Id; 2] {
+    [cos, sin]
 }
 
 /// Candidates of a 1×1 block `a cos θ + b sin θ + c = 0`.
 fn one_angle(arena: &mut Arena, form: &Affine, j: usize) -> Vec<Id> {
     let (a, b) = (form.coefficient(j, COS), form.coefficient(j, SIN));
     circle_line(arena, a, b, form.constant)
-        .map(|point| angle(arena, point))
-        .to_vec()
+        .into_iter()
+        .flat_map(angle)
+        .collect()
 }
 
 /// The candidate (listed twice) of a 1×1 block `k y + c = 0`; `None` if `k` is zero.
@@ -279,8 +288,9 @@ fn one_length(arena: &mut Arena, form: &Affine, j: usize) -> Option<Vec<Id>> {
         return None;
     }
     let minus_c = arena.neg(form.constant);
-    let y = arena.div(minus_c, k);
-    Some(vec![y, y])
+    let value = arena.div(minus_c, k);
+    let y = length(arena, value);
+    Some([y, y].concat())
 }
 
 /// Candidates of a 2×2 block in one length (unknown `l`) and one angle (unknown `a`): the
@@ -314,7 +324,7 @@ fn dyad(arena: &mut Arena, forms: &[Affine], l: usize, a: usize) -> Option<Vec<I
     if arena.is_zero(k) {
         return None;
     }
-    let mut candidates = vec![arena.zero(); 4];
+    let mut candidates = [[arena.zero(); 2]; 4];
     for (i, (x, y)) in points.into_iter().enumerate() {
         // k y + a_cos x + a_sin y + c = 0
         let (cos_term, sin_term) = (
@@ -324,15 +334,16 @@ fn dyad(arena: &mut Arena, forms: &[Affine], l: usize, a: usize) -> Option<Vec<I
         let rest = arena.add(cos_term, sin_term);
         let rest = arena.add(rest, form.constant);
         let minus_rest = arena.neg(rest);
-        candidates[2 * i + l] = arena.div(minus_rest, k);
-        candidates[2 * i + a] = angle(arena, (x, y));
+        let value = arena.div(minus_rest, k);
+        candidates[2 * i + l] = length(arena, value);
+        candidates[2 * i + a] = angle((x, y));
     }
-    Some(candidates)
+    Some(candidates.as_flattened().to_vec())
 }
 
 /// Candidates of a 2×2 block in two angles, `A₁u₁ + A₂u₂ + c = 0`: with `Aₖᵀ Aₖ = rₖ² I`,
 /// `|A₁u₁ + c|² = r₂²` is `2 cᵀA₁ u₁ + |c|² + r₁² − r₂² = 0`, a circle–line equation in θ₁;
-/// then `u₂ ∝ −A₂ᵀ (A₁u₁ + c)`.
+/// then `u₂ = −A₂ᵀ (A₁u₁ + c) / r₂²`.
 fn two_angles(arena: &mut Arena, forms: &[Affine]) -> Option<Vec<Id>> {
     let matrix = |j: usize| {
         [
@@ -360,9 +371,9 @@ fn two_angles(arena: &mut Arena, forms: &[Affine]) -> Option<Vec<Id>> {
         arena.sub(sum, r2)
     };
     let points = circle_line(arena, a, b, constant);
-    let mut candidates = Vec::with_capacity(4);
+    let mut candidates = Vec::with_capacity(8);
     for (x, y) in points {
-        // w = A₁u₁ + c; u₂ ∝ −A₂ᵀ w (a positive factor does not change the angle).
+        // w = A₁u₁ + c; u₂ = −A₂ᵀ w / r₂² (A₂ᵀA₂ = r₂² I), on the unit circle.
         let w: Vec<Id> = (0..2)
             .map(|row| {
                 let (p, q) = (arena.mul(a1[row][0], x), arena.mul(a1[row][1], y));
@@ -378,9 +389,12 @@ fn two_angles(arena: &mut Arena, forms: &[Affine]) -> Option<Vec<Id>> {
             let pq = arena.add(p, q);
             arena.neg(pq)
         };
-        let u2 = (minus_transposed(arena, 0), minus_transposed(arena, 1));
-        candidates.push(angle(arena, (x, y)));
-        candidates.push(angle(arena, u2));
+        let u2 = [0, 1].map(|column| {
+            let scaled = minus_transposed(arena, column);
+            arena.div(scaled, r2)
+        });
+        candidates.extend(angle((x, y)));
+        candidates.extend(angle((u2[0], u2[1])));
     }
     Some(candidates)
 }
@@ -426,10 +440,18 @@ mod tests {
         let n = coordinates.len();
         let known = [0.7, -1.3, 2.1, 0.4];
         let mut solutions = Vec::new();
-        for candidate in form.candidates.chunks(n) {
+        for candidate in form.candidates.chunks(2 * n) {
             let mut q = known.to_vec();
-            for (&c, &value) in coordinates.iter().zip(candidate) {
-                q[c] = at(arena, value, &known);
+            for (&c, pair) in coordinates.iter().zip(candidate.chunks(2)) {
+                let [first, second] = [pair[0], pair[1]].map(|p| at(arena, p, &known));
+                // A length's second entry is the zero node; an angle's pair is on the unit circle.
+                q[c] = if arena.is_zero(pair[1]) {
+                    first
+                } else {
+                    let norm = first.hypot(second);
+                    assert!((norm - 1.0).abs() < 1e-14, "unit vector of norm {norm}");
+                    second.atan2(first)
+                };
             }
             for &r in residuals {
                 let value = at(arena, r, &q);
@@ -513,7 +535,11 @@ mod tests {
         let residual = arena.add(product, known);
         let form = recognize(&mut arena, &[0], &[residual]).expect("closed form");
         assert_eq!(form.kind, ClosedKind::Linear);
-        assert_eq!(form.candidates[0], form.candidates[1]);
+        assert_eq!(form.candidates[..2], form.candidates[2..]);
+        assert!(
+            arena.is_zero(form.candidates[1]),
+            "a length's second entry is 0"
+        );
         let solution = at(&arena, form.candidates[0], &[0.7, -1.3, 2.1, 0.4]);
         assert!((solution * 2.1_f64.cos() + 0.4).abs() < 1e-12);
     }

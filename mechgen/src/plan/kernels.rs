@@ -151,7 +151,8 @@ pub enum Buffer {
     Values,
     /// A right-hand side or a list of values, from 0.
     Out,
-    /// A block's closed-form candidates: two solutions of its coordinates, from 0.
+    /// A block's closed-form candidates: two solutions of its coordinates, two entries per
+    /// coordinate (see [`crate::plan::closed::ClosedForm::candidates`]), from 0.
     Candidates,
 }
 
@@ -299,7 +300,7 @@ impl Kernels {
             Buffer::Q | Buffer::Qd | Buffer::Qdd | Buffer::Lambda => self.sizes.coordinates,
             Buffer::Trig => self.sizes.trig,
             Buffer::Phi | Buffer::Out => shape.map_or(0, |s| s.equations.len()),
-            Buffer::Candidates => shape.map_or(0, |s| 2 * s.equations.len()),
+            Buffer::Candidates => shape.map_or(0, |s| 4 * s.equations.len()),
             Buffer::Values => shape.and_then(|s| s.block.as_ref()).map_or(0, |b| b.slots),
         }
     }
@@ -665,7 +666,7 @@ mod tests {
                 (Stage::Block(block), Method::ClosedForm) => {
                     let closed = block.closed.as_ref().expect("a block with a closed form");
                     assert_eq!(k.kernel.roots, closed.candidates);
-                    assert_eq!(k.kernel.roots.len(), 2 * block.equations.len());
+                    assert_eq!(k.kernel.roots.len(), 4 * block.equations.len());
                     assert!(k.kernel.outputs.iter().all(|o| o.0 == Buffer::Candidates));
                 }
                 (_, Method::FillTrig) => {

@@ -26,8 +26,9 @@ use crate::step::{BlockScales, StepContext, StepReport};
 use crate::structure::Structured;
 
 impl StepContext {
-    /// The sweep's end checks at the step's solution: every position and rate finite, every
-    /// branch invariant of `m` positive (read from the filled trig cache `trig`).
+    /// The sweep's end checks at the step's solution: every rate finite (the positions were,
+    /// by [`StepContext::check_rounding`]), every branch invariant of `m` positive (read from
+    /// the filled trig cache `trig`).
     ///
     /// # Errors
     /// `stage` (the stage count) where one fails: the sweep reports it.
@@ -41,7 +42,7 @@ impl StepContext {
     where
         DefaultAllocator: Storage<M::Dim>,
     {
-        let finite = [q, qd, qdd].iter().all(|v| all_finite(v.as_slice()));
+        let finite = all_finite(qd.as_slice()) && all_finite(qdd.as_slice());
         // NaN is not positive either.
         let branches = (0..m.branch_count()).all(|b| m.branch(b, q, trig) > 0.0);
         if finite && branches {
@@ -49,6 +50,47 @@ impl StepContext {
         } else {
             Err(stage)
         }
+    }
+
+    /// The closed-form solution of block `stage` at `guess` that the sweep would start Newton
+    /// from: of the two `candidates` (the generated code's layout, see
+    /// [`Structured::closed_form`]), the nearest, with its angles (`angles[j]`) moved to the
+    /// guess's turn, trying first the candidate the last step took; recorded in `report`.
+    /// `None` where the sweep would start from the guess itself (near a toggle, a guess
+    /// between the solutions, a loop that cannot close, or `candidates` not `4 N` long).
+    #[inline]
+    pub fn choose<const N: usize, const C: usize>(
+        &self,
+        stage: usize,
+        guess: [f64; N],
+        candidates: &[f64; C],
+        angles: [bool; N],
+        scales: &BlockScales<N>,
+        report: &mut StepReport,
+    ) -> Option<Choice<N>> {
+        if C != 4 * N {
+            return None;
+        }
+        let mut units = [[[0.0; 2]; N]; 2];
+        for (unit, &value) in units
+            .as_flattened_mut()
+            .as_flattened_mut()
+            .iter_mut()
+            .zip(candidates)
+        {
+            *unit = value;
+        }
+        let bit = 1 << (stage % 64);
+        let first = usize::from(self.choices & bit != 0);
+        let (chosen, values) = nearest(&guess, &units, &angles, &scales.inverse_cols, first)?;
+        if chosen == 1 {
+            report.choices |= bit;
+        }
+        Some(Choice {
+            values,
+            units: units[chosen],
+            angles,
+        })
     }
 
     /// The unit scales of a block with these equation and coordinate units.
@@ -213,24 +255,37 @@ impl StepContext {
     }
 }
 
-/// The closed-form solution of a block at `guess` that the sweep would start Newton from:
-/// of the two `candidates` (candidate-major), the nearest, with its angles (`angles[j]`) moved
-/// to the guess's turn; `None` where the sweep would start from the guess itself (near a
-/// toggle, a guess between the solutions, a loop that cannot close, or `candidates` not
-/// `2 N` long).
-#[inline]
-pub fn choose<const N: usize, const C: usize>(
-    guess: [f64; N],
-    candidates: &[f64; C],
+/// A block's chosen closed-form solution.
+#[derive(Debug, Clone, Copy)]
+pub struct Choice<const N: usize> {
+    /// The block's coordinates.
+    pub values: [f64; N],
+    /// Per coordinate, an angle's cosine and sine as the intersection gave them.
+    units: [[f64; 2]; N],
+    /// Which coordinates are angles.
     angles: [bool; N],
-    scales: &BlockScales<N>,
-) -> Option<[f64; N]> {
-    let (first, second) = candidates.split_first_chunk::<N>()?;
-    let second = second.first_chunk::<N>().filter(|_| C == 2 * N)?;
-    let mut candidates = [*first, *second];
-    let nearest = nearest(&guess, &mut candidates, &angles, &scales.inverse_cols)?;
-    Some(candidates[nearest])
 }
+
+impl<const N: usize> Choice<N> {
+    /// The cosine and sine of each angle where the intersection gave them on the unit circle
+    /// to within rounding (a few units in the last place), so that they can fill the trig
+    /// cache in place of a `sin_cos` of the angle; `None` otherwise.
+    #[inline]
+    pub fn units(&self) -> Option<[[f64; 2]; N]> {
+        let on_circle = self
+            .units
+            .iter()
+            .zip(self.angles)
+            .all(|(&[cos, sin], angle)| {
+                !angle || (cos * cos + sin * sin - 1.0).abs() <= UNIT_ROUNDING
+            });
+        on_circle.then_some(self.units)
+    }
+}
+
+/// How far from 1 the squared length of an intersection's unit vector may be for its cosine
+/// and sine to stand for the angle's: a few roundings.
+const UNIT_ROUNDING: f64 = 8.0 * f64::EPSILON;
 
 /// `max |v_j c_j|`, NaN winning.
 fn scaled_max<const N: usize>(v: &[f64; N], c: &[f64; N]) -> f64 {

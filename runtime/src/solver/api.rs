@@ -65,6 +65,9 @@ where
     /// `position` module's escape): [`crate::Simulation::new`] tries the other side when the
     /// first leads off a declared branch.
     pub(crate) escape_side: f64,
+    /// The closed-form candidates the last straight step took (its
+    /// [`crate::step::StepReport`]'s `choices`): the next one tries them first.
+    pub(super) closed_choices: u64,
 }
 
 /// A copy with its own workspace (to run the same scene on another thread, or to restart
@@ -82,6 +85,7 @@ where
             length: self.length,
             diagnosed: self.diagnosed,
             escape_side: self.escape_side,
+            closed_choices: self.closed_choices,
         }
     }
 }
@@ -104,6 +108,7 @@ where
             length: LengthScale::new(1.0),
             diagnosed: (0, 0),
             escape_side: 1.0,
+            closed_choices: 0,
         }
     }
 

@@ -44,28 +44,29 @@ where
         self.check_inputs(t, &state.q, Quantity::Guess)?;
         self.check_parameters(t)?;
         self.update_scale();
-        let context = StepContext::new(&options, self.length);
+        let context = StepContext::new(&options, self.length, self.closed_choices);
         let mut report = StepReport::new(options.estimate_condition);
         let m = &self.mechanism;
-        let parts = self.workspace.parts();
+        let trig = self.workspace.trig();
         let (q, qd, qdd) = (
             &mut state.q,
             &mut state.velocities,
             &mut state.accelerations,
         );
-        if m.straight_step(t, q, qd, qdd, parts.trig, &context, &mut report)
+        if m.straight_step(t, q, qd, qdd, trig, &context, &mut report)
             .is_err()
         {
             return Ok(None);
         }
         // The step made the sweep's end checks (`StepContext::check_end`) but the markers'.
         if !state.markers.as_ref().is_empty() {
-            m.markers(q, parts.trig, qd, qdd, t, &mut state.markers);
+            m.markers(q, trig, qd, qdd, t, &mut state.markers);
             if !all_finite(state.markers.as_ref()) {
                 return Ok(None);
             }
         }
         self.diagnosed = (0, 0);
+        self.closed_choices = report.choices;
         Ok(Some(Convergence {
             iterations: 0,
             residual: report.residual,
