@@ -12,8 +12,9 @@ use quote::{format_ident, quote};
 use super::body::Context;
 use super::idx;
 use super::plan::{Kernel, named_kernel_function};
+use crate::expr::Id;
 use crate::model::{Outputs, Unit};
-use crate::plan::kernels::{Kernels, Method, StageKernel};
+use crate::plan::kernels::{Buffer, Kernels, Method, StageKernel};
 use crate::plan::trig::Phase;
 
 /// The straight step of a scene that can have one: the inherent function that runs the
@@ -100,6 +101,11 @@ impl Stages {
         });
         let vector = cx.vector_type();
         let (stages, variants) = (&self.code, &self.variants);
+        let EndChecks {
+            lengths,
+            angles,
+            rates,
+        } = EndChecks::of(cx, kernels);
         quote! {
             /// The straight kinematic step's stages, in solve order (see
             /// `Structured::straight_step`).
@@ -117,11 +123,65 @@ impl Stages {
                 #view
                 #(#stages)*
                 let end = Self::STAGES.len();
-                context.check_rounding(end, q.as_slice(), &Self::COORDINATE_UNITS)?;
-                context.check_end(end, self, [q, qd, qdd], trig_cache)?;
+                context.check_rounding(end, &[#(#lengths),*], &[#(#angles),*])?;
+                context.check_end(end, self, q, &[#(#rates),*], trig_cache)?;
                 ::core::result::Result::Ok(())
             }
             #(#variants)*
+        }
+    }
+}
+
+/// What the step's end checks read: the positions of each unit the rounding bound applies to
+/// (a constant 0 always passes), and the rates the explicit stages compute that are not
+/// constants (the blocks' rates are checked as they are solved).
+struct EndChecks {
+    lengths: Vec<TokenStream>,
+    angles: Vec<TokenStream>,
+    rates: Vec<TokenStream>,
+}
+
+impl EndChecks {
+    fn of(cx: &Context<'_>, kernels: &Kernels) -> Self {
+        let arena = cx.arena();
+        let constant = |root: Id| arena.as_const(root).filter(|c| c.is_finite());
+        let written = |methods: &[Method], keep: &dyn Fn(Id) -> bool| -> Vec<(Buffer, usize)> {
+            let kernels = kernels
+                .stages
+                .iter()
+                .filter(|k| methods.contains(&k.method));
+            kernels
+                .flat_map(|k| k.kernel.roots.iter().zip(&k.kernel.outputs))
+                .filter(|&(&root, _)| keep(root))
+                .map(|(_, &output)| output)
+                .collect()
+        };
+        let zeros = written(&[Method::Positions], &|root| constant(root) == Some(0.0));
+        let units = cx.model.coordinate_units();
+        let (mut lengths, mut angles) = (Vec::new(), Vec::new());
+        for (c, &unit) in units.iter().enumerate() {
+            if zeros.contains(&(Buffer::Q, c)) {
+                continue;
+            }
+            let c = idx(c);
+            match unit {
+                Unit::Angle => angles.push(quote!(q[#c])),
+                _ => lengths.push(quote!(q[#c])),
+            }
+        }
+        let rates = written(&[Method::Velocities, Method::Accelerations], &|root| {
+            constant(root).is_none()
+        })
+        .into_iter()
+        .map(|(buffer, c)| {
+            let (name, c) = (format_ident!("{}", buffer.name()), idx(c));
+            quote!(#name[#c])
+        })
+        .collect();
+        EndChecks {
+            lengths,
+            angles,
+            rates,
         }
     }
 }

@@ -26,9 +26,10 @@ use crate::step::{BlockScales, StepContext, StepReport};
 use crate::structure::Structured;
 
 impl StepContext {
-    /// The sweep's end checks at the step's solution: every rate finite (the positions were,
-    /// by [`StepContext::check_rounding`]), every branch invariant of `m` positive (read from
-    /// the filled trig cache `trig`).
+    /// The sweep's end checks at the step's solution `q`: every rate finite, every branch
+    /// invariant of `m` positive (read from the filled trig cache `trig`). `rates` are the
+    /// rates the explicit stages computed (constants left out); the blocks' were checked by
+    /// [`StepContext::rates`], the positions by [`StepContext::check_rounding`].
     ///
     /// # Errors
     /// `stage` (the stage count) where one fails: the sweep reports it.
@@ -36,13 +37,14 @@ impl StepContext {
         &self,
         stage: usize,
         m: &M,
-        [q, qd, qdd]: [&Vector<M::Dim>; 3],
+        q: &Vector<M::Dim>,
+        rates: &[f64],
         trig: &[f64],
     ) -> Result<(), usize>
     where
         DefaultAllocator: Storage<M::Dim>,
     {
-        let finite = all_finite(qd.as_slice()) && all_finite(qdd.as_slice());
+        let finite = all_finite(rates);
         // NaN is not positive either.
         let branches = (0..m.branch_count()).all(|b| m.branch(b, q, trig) > 0.0);
         if finite && branches {
@@ -58,7 +60,8 @@ impl StepContext {
     /// guess's turn, trying first the candidate the last step took; recorded in `report`.
     /// `None` where the sweep would start from the guess itself (near a toggle, a guess
     /// between the solutions, a loop that cannot close, or `candidates` not `4 N` long).
-    #[inline]
+    // Inlined so that the block's constant `angles` fold away.
+    #[inline(always)]
     pub fn choose<const N: usize, const C: usize>(
         &self,
         stage: usize,
@@ -235,19 +238,25 @@ impl StepContext {
         }
     }
 
-    /// Whether explicit assignments can be accepted unevaluated at `q` (the sweep's rounding
-    /// bound, see [`crate::acceptance`]): every scaled coordinate below it. Above, the sweep's
-    /// evaluation of the explicit residuals decides.
+    /// Whether explicit assignments can be accepted unevaluated at the step's positions (the
+    /// sweep's rounding bound, see [`crate::acceptance`]): every scaled coordinate below it.
+    /// Above, the sweep's evaluation of the explicit residuals decides. `lengths` and `angles`
+    /// are the coordinates of each unit (those assigned a constant 0 left out).
     ///
     /// # Errors
     /// `stage` above the bound (or for a non-finite coordinate).
     #[inline]
-    pub fn check_rounding(&self, stage: usize, q: &[f64], units: &[Unit]) -> Result<(), usize> {
+    pub fn check_rounding(
+        &self,
+        stage: usize,
+        lengths: &[f64],
+        angles: &[f64],
+    ) -> Result<(), usize> {
         let bound = self.acceptance / (f64::EPSILON * COEFFICIENT_ROOM);
-        let magnitude = q.iter().zip(units).fold(0.0_f64, |m, (&x, &u)| {
-            larger(m, (x * self.length.inverse_of(u)).abs())
-        });
-        if magnitude <= bound {
+        // The length scale is a power of two: `|x| L⁻¹ ≤ bound` exactly where `|x| ≤ bound L`.
+        // NaN fails the comparison; no branch per coordinate.
+        let within = |v: &[f64], bound: f64| v.iter().fold(true, |ok, x| ok & (x.abs() <= bound));
+        if within(lengths, bound * self.length.of(Unit::Length)) & within(angles, bound) {
             Ok(())
         } else {
             Err(stage)

@@ -96,7 +96,7 @@ where
 /// the candidate `first` (the one tried first: 0, or the last step's choice), as while
 /// stepping; anywhere else both angles are computed and the exact rule ([`nearest_of`])
 /// decides. The answer does not depend on `first`.
-#[inline]
+#[inline(always)]
 pub(crate) fn nearest<const N: usize>(
     guess: &[f64; N],
     candidates: &[Units<N>; 2],
