@@ -6,7 +6,8 @@
 
 use mechgen_interp::Interpreted;
 use mechgen_runtime::{
-    Dense, Requirement, SolveError, Solver, Structured, Subject, Vector, nalgebra::DefaultAllocator,
+    Dense, Mechanism, Requirement, SolveError, Solver, Structured, Subject, Vector,
+    nalgebra::DefaultAllocator,
 };
 use mechgen_tests::twin;
 
@@ -178,5 +179,42 @@ fn constant_physics_generates_no_check() {
             generated,
             "{generated}:\n{source}"
         );
+    }
+}
+
+/// A solver checks its parameters once, not on every solve, but again after any change
+/// through `mechanism_mut`: a bad value set between two solves of one solver is refused by
+/// the next, and the good value set back solves again.
+#[test]
+fn a_solver_checks_parameters_set_between_its_solves() {
+    let m = Loaded::default();
+    let mut guess = Vector::<<Loaded as Mechanism>::Dim>::zeros();
+    m.initial_guess(&mut guess);
+    let mut solver = Solver::new(m);
+    solver.solve(0.1, &guess).expect("the defaults solve");
+    for (parameter, value, requirement, ..) in BAD {
+        let m = solver.mechanism();
+        let index = (0..m.parameter_count()).find(|&i| m.parameter_name(i) == Some(parameter));
+        let good = index.and_then(|i| m.parameter(i)).expect("declared");
+        solver
+            .mechanism_mut()
+            .set_parameter(parameter, value)
+            .unwrap();
+        match solver.solve(0.1, &guess) {
+            Err(
+                SolveError::Physics { requirement: r, .. }
+                | SolveError::Geometry { requirement: r, .. },
+            ) => {
+                assert_eq!(r, requirement, "{parameter} = {value}");
+            }
+            other => panic!("{parameter} = {value}: {other:?}"),
+        }
+        solver
+            .mechanism_mut()
+            .set_parameter(parameter, good)
+            .unwrap();
+        solver
+            .solve(0.1, &guess)
+            .expect("the good value solves again");
     }
 }

@@ -68,6 +68,9 @@ where
     /// The closed-form candidates the last straight step took (its
     /// [`crate::step::StepReport`]'s `choices`): the next one tries them first.
     pub(super) closed_choices: u64,
+    /// Whether the parameters passed their checks and gave the length scale since the
+    /// mechanism or the options last changed ([`Solver::check_mechanism`]).
+    pub(super) checked: bool,
 }
 
 /// A copy with its own workspace (to run the same scene on another thread, or to restart
@@ -86,6 +89,7 @@ where
             diagnosed: self.diagnosed,
             escape_side: self.escape_side,
             closed_choices: self.closed_choices,
+            checked: self.checked,
         }
     }
 }
@@ -109,6 +113,7 @@ where
             diagnosed: (0, 0),
             escape_side: 1.0,
             closed_choices: 0,
+            checked: false,
         }
     }
 
@@ -117,8 +122,10 @@ where
         &self.mechanism
     }
 
-    /// The mechanism, for setting parameters between solves. Its `dim()` must not change.
+    /// The mechanism, for setting parameters between solves (the next solve checks them and
+    /// their length scale again). Its `dim()` must not change.
     pub fn mechanism_mut(&mut self) -> &mut M {
+        self.checked = false;
         &mut self.mechanism
     }
 
@@ -134,6 +141,7 @@ where
 
     /// Replaces the options.
     pub fn set_options(&mut self, options: SolverOptions) {
+        self.checked = false;
         self.options = options;
     }
 

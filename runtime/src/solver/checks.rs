@@ -15,10 +15,23 @@ impl<M: Structured> Solver<M>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
+    /// Every parameter finite, and the geometry and physics written in them valid
+    /// ([`Solver::check_parameters`]), and the length scale of the parameters: once after the
+    /// mechanism or the options may have changed (`mechanism_mut`, `set_options`), not on
+    /// every solve. A failed check is made again by the next solve.
+    pub(crate) fn check_mechanism(&mut self, t: f64) -> Result<(), SolveError> {
+        if !self.checked {
+            self.check_parameters(t)?;
+            self.update_scale();
+            self.checked = true;
+        }
+        Ok(())
+    }
+
     /// Every parameter finite, and the geometry and physics written in them valid: a NaN set
     /// through a public field, a distance or a mass set negative, is reported as itself, not as
     /// the NaN Φ, the singular Jacobian or the wrong forces it would cause.
-    pub(crate) fn check_parameters(&self, t: f64) -> Result<(), SolveError> {
+    fn check_parameters(&self, t: f64) -> Result<(), SolveError> {
         let m = &self.mechanism;
         match (0..m.parameter_count()).find(|&i| !m.parameter(i).is_some_and(f64::is_finite)) {
             Some(index) => Err(non_finite(t, Quantity::Parameter(index))),

@@ -32,7 +32,7 @@ where
         qdd: &mut Vector<M::Dim>,
         rates: Rates,
     ) -> Result<(), SolveError> {
-        self.check_parameters(t)?;
+        self.check_mechanism(t)?;
         let mut reached = 0;
         self.rate_sweep(t, q, qd, qdd, rates, &mut reached)
             .map_err(|e| origin::trace(&self.mechanism, reached, [q, qd, qdd], rates, e))
@@ -49,7 +49,6 @@ where
         rates: Rates,
         reached: &mut usize,
     ) -> Result<(), SolveError> {
-        self.update_scale();
         self.diagnosed = (0, 0);
         let Self {
             mechanism: m,

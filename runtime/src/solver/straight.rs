@@ -42,8 +42,7 @@ where
             return Ok(None);
         }
         self.check_inputs(t, &state.q, Quantity::Guess)?;
-        self.check_parameters(t)?;
-        self.update_scale();
+        self.check_mechanism(t)?;
         let context = StepContext::new(&options, self.length, self.closed_choices);
         let mut report = StepReport::new(options.estimate_condition);
         let m = &self.mechanism;

@@ -48,7 +48,7 @@ where
         extras: Option<Extras<'_, M>>,
     ) -> Result<Convergence, SolveError> {
         self.check_inputs(t, q, Quantity::Guess)?;
-        self.check_parameters(t)?;
+        self.check_mechanism(t)?;
         let mut reached = 0;
         self.sweep(t, q, qd, qdd, rates, extras, &mut reached)
             .map_err(|e| origin::trace(&self.mechanism, reached, [q, qd, qdd], rates, e))
@@ -69,7 +69,6 @@ where
         reached: &mut usize,
     ) -> Result<Convergence, SolveError> {
         // Kept whole: one pass over the stages; its arms share the solver and the running totals.
-        self.update_scale();
         self.diagnosed = (0, 0);
         let Self {
             mechanism: m,
@@ -79,6 +78,7 @@ where
             diagnosed,
             escape_side,
             closed_choices: _,
+            checked: _,
         } = self;
         let mut parts = workspace.parts();
         let mut total = Convergence::start(options.estimate_condition);
