@@ -10,6 +10,7 @@ use crate::error::{Described, Quantity, SolveError};
 use crate::mechanism::{Accelerations, LengthScale, Storage, Vector, Velocities};
 use crate::options::{Rates, SolverOptions};
 use crate::state::State;
+use crate::step::StepContext;
 use crate::structure::Structured;
 use crate::workspace::Workspace;
 
@@ -71,6 +72,8 @@ where
     /// Whether the parameters passed their checks and gave the length scale since the
     /// mechanism or the options last changed ([`Solver::check_mechanism`]).
     pub(super) checked: bool,
+    /// The straight step's settings at the length scale, made with the check.
+    pub(super) context: StepContext,
 }
 
 /// A copy with its own workspace (to run the same scene on another thread, or to restart
@@ -90,6 +93,7 @@ where
             escape_side: self.escape_side,
             closed_choices: self.closed_choices,
             checked: self.checked,
+            context: self.context,
         }
     }
 }
@@ -114,6 +118,7 @@ where
             escape_side: 1.0,
             closed_choices: 0,
             checked: false,
+            context: StepContext::new(&options, LengthScale::new(1.0), 0),
         }
     }
 

@@ -9,6 +9,7 @@ use crate::error::{Quantity, SolveError};
 use crate::finite::{check_finite, non_finite};
 use crate::mechanism::{Storage, Vector};
 use crate::names::Names;
+use crate::step::StepContext;
 use crate::structure::Structured;
 
 impl<M: Structured> Solver<M>
@@ -23,6 +24,7 @@ where
         if !self.checked {
             self.check_parameters(t)?;
             self.update_scale();
+            self.context = StepContext::new(&self.options, self.length, 0);
             self.checked = true;
         }
         Ok(())

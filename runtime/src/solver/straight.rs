@@ -36,15 +36,18 @@ where
         state: &mut State<M>,
         rates: Rates,
     ) -> Result<Option<Convergence>, SolveError> {
-        let options = self.options;
+        let options = &self.options;
         let enabled = options.straight_step && options.closed_forms && options.static_pivots;
         if !(enabled && rates == Rates::Both) {
             return Ok(None);
         }
         self.check_inputs(t, &state.q, Quantity::Guess)?;
         self.check_mechanism(t)?;
-        let context = StepContext::new(&options, self.length, self.closed_choices);
-        let mut report = StepReport::new(options.estimate_condition);
+        let context = StepContext {
+            choices: self.closed_choices,
+            ..self.context
+        };
+        let mut report = StepReport::new(context.estimate_condition);
         let m = &self.mechanism;
         let trig = self.workspace.trig();
         let (q, qd, qdd) = (
