@@ -211,12 +211,17 @@ pub(crate) fn scales<F: Dim>(length: f64, units: impl Fn(usize) -> i32, out: &mu
 where
     DefaultAllocator: Storage<F>,
 {
-    let length = if length.is_finite() && length > 0.0 {
+    let length = usable_length(length);
+    for k in 0..out.len() {
+        out[k] = powi(length, units(k));
+    }
+}
+
+/// The scene's length scale where it is usable (finite and positive), 1 otherwise.
+pub(crate) fn usable_length(length: f64) -> f64 {
+    if length.is_finite() && length > 0.0 {
         length
     } else {
         1.0
-    };
-    for k in 0..out.len() {
-        out[k] = powi(length, units(k));
     }
 }
