@@ -74,7 +74,7 @@ where
     /// the last two steps are even). The step is the one the clock takes, `t − t0`;
     /// [`DynamicsError::StepBelowClock`] when that is not the step planned (to a hundredth).
     fn plan(&self, limit: Option<f64>) -> Result<(f64, f64, bool), DynamicsError> {
-        let t0 = self.state.t;
+        let t0 = self.states.current().t;
         let (h, adaptive) = match self.options.control {
             StepControl::Fixed { step } => (step, false),
             StepControl::Adaptive { max, .. } => (self.step.min(max), true),
@@ -116,7 +116,7 @@ where
         Err(match failure {
             Failure::Kinematics(_) | Failure::Toggle => self.failure(failure, t, h),
             _ => DynamicsError::StepTooSmall {
-                t: self.state.t,
+                t: self.states.current().t,
                 step: next,
                 min,
             },
@@ -135,11 +135,12 @@ where
     fn accept(&mut self, h: f64) {
         self.earlier.copy_from(&self.now.udd);
         self.earlier_step = h;
-        core::mem::swap(&mut self.state, &mut self.trial);
+        self.states.accept();
         core::mem::swap(&mut self.now, &mut self.next);
         self.reduced.accepted.copy_from(&self.reduced.v);
         let m = self.solver.mechanism();
-        self.book.advance(m, &self.state, &self.reduced.forces, h);
+        self.book
+            .advance(m, self.states.current(), &self.reduced.forces, h);
         self.stats.steps += 1;
     }
 }

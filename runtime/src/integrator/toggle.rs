@@ -82,7 +82,7 @@ where
     /// Whether the step of size `h` from the current state to `trial` (`now` to `next`)
     /// changed a sign, grew `‖V‖` or kinked `q` (the module documentation).
     fn at_toggle(&mut self, h: f64) -> bool {
-        let (before, after) = (&self.state, &self.trial);
+        let (before, after) = (self.states.current(), self.states.trial());
         let same_side =
             before.orientation == after.orientation && before.block_signs == after.block_signs;
         let near = self.reduced.v.norm() > TOGGLE_GROWTH * self.sensitivity;
@@ -129,7 +129,7 @@ where
             d_u[k] = defect([from.ud[k], to.ud[k]], [from.udd[k], to.udd[k]], h);
             jump[k] = to.udd[k] - from.udd[k];
         }
-        let (before, after) = (&self.state, &self.trial);
+        let (before, after) = (self.states.current(), self.states.trial());
         let (v0, v1) = (&before.velocities, &after.velocities);
         let (a0, a1) = (&before.accelerations, &after.accelerations);
         let (start, end) = (&self.reduced.accepted, &self.reduced.v);

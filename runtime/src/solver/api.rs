@@ -65,6 +65,10 @@ where
     /// `position` module's escape): [`crate::Simulation::new`] tries the other side when the
     /// first leads off a declared branch.
     pub(crate) escape_side: f64,
+    /// Whether the force solve's archive holds the block factors at the positions of the last
+    /// solve (a full solve of a scene that computes forces, through the stage sweep): what
+    /// [`Solver::solve_velocity_again`] solves with.
+    pub(super) factors_archived: bool,
 }
 
 /// A copy with its own workspace (to run the same scene on another thread, or to restart
@@ -82,6 +86,7 @@ where
             length: self.length,
             diagnosed: self.diagnosed,
             escape_side: self.escape_side,
+            factors_archived: self.factors_archived,
         }
     }
 }
@@ -104,6 +109,7 @@ where
             length: LengthScale::new(1.0),
             diagnosed: (0, 0),
             escape_side: 1.0,
+            factors_archived: false,
         }
     }
 
@@ -210,6 +216,7 @@ where
         self.check_len(&state.accelerations)?;
         self.check_len(&state.reactions)?;
         let rates = Rates::of(self.mechanism.outputs());
+        self.factors_archived = false;
         let straight = self.straight_solve(t, state, rates)?;
         let convergence = match straight {
             Some(convergence) => convergence,
@@ -225,6 +232,8 @@ where
                 }),
             )?,
         };
+        // The sweep archives the factors for the force solve (the straight step has none).
+        self.factors_archived = straight.is_none() && rates == Rates::Forces;
         state.t = t;
         state.iterations = convergence.iterations;
         state.condition = convergence.condition;
@@ -257,6 +266,7 @@ where
         t: f64,
     ) -> Result<Convergence, SolveError> {
         let (mut qd, mut qdd) = (q.clone(), q.clone());
+        self.factors_archived = false;
         self.solve_stages(t, q, &mut qd, &mut qdd, Rates::None, None)
             .map_err(|e| self.named(e))
     }

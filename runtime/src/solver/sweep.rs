@@ -78,6 +78,7 @@ where
             length,
             diagnosed,
             escape_side,
+            ..
         } = self;
         let mut parts = workspace.parts();
         let mut total = Convergence::start(options.estimate_condition);
