@@ -65,8 +65,9 @@ where
     /// `position` module's escape): [`crate::Simulation::new`] tries the other side when the
     /// first leads off a declared branch.
     pub(crate) escape_side: f64,
-    /// Whether the force solve's archive holds the block factors at the positions of the last
-    /// solve (a full solve of a scene that computes forces, through the stage sweep): what
+    /// Whether the force solve's archive holds the block factors, and the trig cache the
+    /// sines and cosines, at the positions of the last solve (a full solve of a scene that
+    /// computes forces, through the stage sweep, and no rate solve since): what
     /// [`Solver::solve_velocity_again`] solves with.
     pub(super) factors_archived: bool,
 }
