@@ -267,6 +267,15 @@ where
         scale(x, scales.rows);
     }
 
+    /// [`BlockSolve::solve`] with static factors kept elsewhere (`values`: the force solve's
+    /// archive of the block's factored slots).
+    pub fn solve_static(&self, values: &[f64], scales: &Scales<'_>, x: &mut [f64]) {
+        let x = &mut x[..self.n()];
+        scale(x, scales.rows);
+        self.m.solve(self.stage, values, x);
+        scale(x, scales.cols);
+    }
+
     /// [`BlockSolve::solve_transpose`] with static factors kept elsewhere (`values`: the force
     /// solve's archive of the block's factored slots).
     pub fn solve_transpose_static(&self, values: &[f64], scales: &Scales<'_>, x: &mut [f64]) {

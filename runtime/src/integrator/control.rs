@@ -74,7 +74,7 @@ where
     /// the last two steps are even). The step is the one the clock takes, `t − t0`;
     /// [`DynamicsError::StepBelowClock`] when that is not the step planned (to a hundredth).
     fn plan(&self, limit: Option<f64>) -> Result<(f64, f64, bool), DynamicsError> {
-        let t0 = self.state.t;
+        let t0 = self.states.current().t;
         let (h, adaptive) = match self.options.control {
             StepControl::Fixed { step } => (step, false),
             StepControl::Adaptive { max, .. } => (self.step.min(max), true),
@@ -116,7 +116,7 @@ where
         Err(match failure {
             Failure::Kinematics(_) | Failure::Toggle => self.failure(failure, t, h),
             _ => DynamicsError::StepTooSmall {
-                t: self.state.t,
+                t: self.states.current().t,
                 step: next,
                 min,
             },
@@ -135,11 +135,12 @@ where
     fn accept(&mut self, h: f64) {
         self.earlier.copy_from(&self.now.udd);
         self.earlier_step = h;
-        core::mem::swap(&mut self.state, &mut self.trial);
+        self.states.accept();
         core::mem::swap(&mut self.now, &mut self.next);
         self.reduced.accepted.copy_from(&self.reduced.v);
         let m = self.solver.mechanism();
-        self.book.advance(m, &self.state, &self.reduced.forces, h);
+        self.book
+            .advance(m, self.states.current(), &self.reduced.forces, h);
         self.stats.steps += 1;
     }
 }
@@ -211,12 +212,17 @@ pub(crate) fn scales<F: Dim>(length: f64, units: impl Fn(usize) -> i32, out: &mu
 where
     DefaultAllocator: Storage<F>,
 {
-    let length = if length.is_finite() && length > 0.0 {
+    let length = usable_length(length);
+    for k in 0..out.len() {
+        out[k] = powi(length, units(k));
+    }
+}
+
+/// The scene's length scale where it is usable (finite and positive), 1 otherwise.
+pub(crate) fn usable_length(length: f64) -> f64 {
+    if length.is_finite() && length > 0.0 {
         length
     } else {
         1.0
-    };
-    for k in 0..out.len() {
-        out[k] = powi(length, units(k));
     }
 }

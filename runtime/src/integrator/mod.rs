@@ -13,7 +13,7 @@
 //! One concept per file: the [`Integrator`] and its API (here), the method's coefficients and
 //! update (`alpha.rs`), one evaluation of the reduced equations (`reduced.rs`), the step's
 //! modified Newton iteration (`newton.rs`), step control and landing on requested times
-//! (`control.rs`), the [`IntegratorOptions`] (`options.rs`), the [`Energy`] book (`energy.rs`)
+//! (`control.rs`), the current state and the step's iterate (`states.rs`), the [`IntegratorOptions`] (`options.rs`), the [`Energy`] book (`energy.rs`)
 //! and the [`DynamicsError`] (`error.rs`).
 
 mod alpha;
@@ -23,6 +23,7 @@ mod error;
 mod newton;
 mod options;
 mod reduced;
+mod states;
 mod toggle;
 
 pub use energy::Energy;
@@ -35,6 +36,7 @@ use self::alpha::{Alpha, FreeMotion};
 use self::energy::Book;
 use self::newton::{Failure, IterationMatrix};
 use self::reduced::{Reduced, set_free};
+use self::states::States;
 use crate::assembly::GUESS_TIME;
 use crate::dynamic::{Dynamic, EquationsOfMotion, FreeStorage};
 #[cfg(doc)]
@@ -73,8 +75,7 @@ where
 {
     solver: Solver<M>,
     /// The state at the current time, and the iterate of the step being solved.
-    state: State<M>,
-    trial: State<M>,
+    states: States<M>,
     /// The free coordinates at the current time, and the step's iterate.
     now: FreeMotion<M::Free>,
     next: FreeMotion<M::Free>,
@@ -106,8 +107,7 @@ where
     fn clone(&self) -> Self {
         Self {
             solver: self.solver.clone(),
-            state: self.state.clone(),
-            trial: self.trial.clone(),
+            states: self.states.clone(),
             now: self.now.clone(),
             next: self.next.clone(),
             reduced: self.reduced.clone(),
@@ -186,8 +186,7 @@ where
             StepControl::Adaptive { initial, .. } => initial,
         };
         Self {
-            trial: state.clone(),
-            state,
+            states: States::new(state),
             now: initial.clone(),
             next: initial,
             reduced: Reduced::new(m, slopes),
@@ -209,9 +208,10 @@ where
     /// accelerations from the equations of motion (linear in `ü`: one solve with the reduced
     /// mass), the state solved there. On failure the current state is untouched.
     fn restart(&mut self) -> Result<(), DynamicsError> {
-        let t = self.state.t;
+        let t = self.states.current().t;
         self.next.udd.fill(0.0);
-        self.trial.copy_from(&self.state);
+        let (state, trial) = self.states.split();
+        trial.copy_from(state);
         self.matrix.step = None;
         let solved = self
             .evaluate(t)
@@ -228,11 +228,12 @@ where
         self.sensitivity = self.reduced.v.norm();
         self.reduced.accepted.copy_from(&self.reduced.v);
         self.earlier_step = 0.0;
-        core::mem::swap(&mut self.state, &mut self.trial);
+        self.states.accept();
         core::mem::swap(&mut self.now, &mut self.next);
         let m = self.solver.mechanism();
-        self.reduced.measure_forces(m, &self.state);
-        self.book.restart(m, &self.state, &self.reduced.forces);
+        self.reduced.measure_forces(m, self.states.current());
+        self.book
+            .restart(m, self.states.current(), &self.reduced.forces);
         Ok(())
     }
 
@@ -272,13 +273,13 @@ where
 
     /// The current time.
     pub fn t(&self) -> f64 {
-        self.state.t
+        self.states.current().t
     }
 
     /// The state at the current time: `q`, `q̇`, `q̈` (and the reactions) as a kinematic
     /// solve gives them at the free coordinates' state.
     pub fn state(&self) -> &State<M> {
-        &self.state
+        self.states.current()
     }
 
     /// `[u, u̇, ü]` of free degree of freedom `k` (declaration order); NaNs past the end.
@@ -352,7 +353,7 @@ where
     /// None at present: every accepted state carries its force solve (the signature leaves
     /// room for solving it on demand).
     pub fn constraint_forces(&mut self) -> Result<&Vector<M::Dim>, DynamicsError> {
-        Ok(self.state.constraint_forces())
+        Ok(self.states.current().constraint_forces())
     }
 
     /// Takes one accepted step (the fixed step, or the size the error control chose, retried
@@ -365,7 +366,7 @@ where
     /// [`DynamicsError::NonFinite`]; the state is then unchanged.
     pub fn step(&mut self) -> Result<&State<M>, DynamicsError> {
         self.advance(None)?;
-        Ok(&self.state)
+        Ok(self.states.current())
     }
 
     /// Steps until the time is exactly `t` (the last step shortened to land on it).
@@ -376,11 +377,11 @@ where
     pub fn step_to(&mut self, t: f64) -> Result<&State<M>, DynamicsError> {
         self.check_target(t)?;
         let mut steps = 0;
-        while self.state.t < t {
+        while self.states.current().t < t {
             self.budget(&mut steps)?;
             self.advance(Some(t))?;
         }
-        Ok(&self.state)
+        Ok(self.states.current())
     }
 
     /// Steps until `t_end` (landing on it exactly), calling `each` with the state and the
@@ -395,10 +396,10 @@ where
     ) -> Result<(), DynamicsError> {
         self.check_target(t_end)?;
         let mut steps = 0;
-        while self.state.t < t_end {
+        while self.states.current().t < t_end {
             self.budget(&mut steps)?;
             self.advance(Some(t_end))?;
-            each(&self.state, &self.book.energy);
+            each(self.states.current(), &self.book.energy);
         }
         Ok(())
     }
@@ -412,7 +413,7 @@ where
     fn budget(&self, steps: &mut u64) -> Result<(), DynamicsError> {
         if *steps >= self.options.max_steps {
             return Err(DynamicsError::StepBudget {
-                t: self.state.t,
+                t: self.states.current().t,
                 steps: *steps,
             });
         }
@@ -422,7 +423,7 @@ where
 
     /// A target time must be finite and not behind.
     fn check_target(&self, t: f64) -> Result<(), DynamicsError> {
-        if t.is_finite() && t >= self.state.t {
+        if t.is_finite() && t >= self.states.current().t {
             Ok(())
         } else {
             Err(DynamicsError::BadOptions {

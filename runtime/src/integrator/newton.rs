@@ -305,15 +305,15 @@ where
         if linear {
             self.linear_prediction(h);
         }
-        self.trial.copy_from(&self.state);
+        // Only the positions: the solve writes the rest of the state.
+        let (state, trial) = self.states.split();
+        trial.q.copy_from(&state.q);
         self.correction.copy_from(&self.next.u);
         self.correction -= &self.now.u;
-        self.trial
-            .q
-            .gemv(1.0, &self.reduced.v, &self.correction, 1.0);
-        if self.trial.q.iter().any(|x| !x.is_finite()) {
+        trial.q.gemv(1.0, &self.reduced.v, &self.correction, 1.0);
+        if trial.q.iter().any(|x| !x.is_finite()) {
             // A V left by a failed restart elsewhere: start from the positions as they are.
-            self.trial.q.copy_from(&self.state.q);
+            trial.q.copy_from(&state.q);
         }
         Ok(())
     }
@@ -346,22 +346,22 @@ where
             self.solve_v()?;
         }
         let m = self.solver.mechanism();
-        self.reduced.measure_forces(m, &self.trial);
+        self.reduced.measure_forces(m, self.states.trial());
         self.check_crossing(h)
     }
 
     /// `V` at the last evaluation (`next`, solved into `trial`).
     pub(super) fn solve_v(&mut self) -> Result<(), Failure> {
-        let t = self.trial.t;
+        let trial = self.states.trial();
         self.reduced
-            .sensitivities(&mut self.solver, t, &self.next, &self.trial)
+            .sensitivities(&mut self.solver, trial.t, &self.next, trial)
             .map_err(Failure::Kinematics)
     }
 
     /// Evaluates the residual at `next`, into `trial`.
     pub(super) fn evaluate(&mut self, t: f64) -> Result<(), Failure> {
         self.reduced
-            .evaluate(&mut self.solver, t, &self.next, &mut self.trial)
+            .evaluate(&mut self.solver, t, &self.next, self.states.trial_mut())
             .map_err(Failure::Kinematics)?;
         if self.reduced.residual.iter().all(|r| r.is_finite()) {
             Ok(())
@@ -379,12 +379,13 @@ where
         let it = &mut self.matrix;
         it.built = false;
         it.step = None;
-        self.reduced.mass(m, &self.trial, &mut it.mass);
+        let trial = self.states.trial();
+        self.reduced.mass(m, trial, &mut it.mass);
         it.scratch.copy_from(&it.mass);
         check_mass(&mut it.scratch, &it.scales)?;
         it.has = (
-            self.reduced.damping(m, &self.trial, &mut it.damping),
-            self.reduced.stiffness(m, &self.trial, &mut it.stiffness),
+            self.reduced.damping(m, trial, &mut it.damping),
+            self.reduced.stiffness(m, trial, &mut it.stiffness),
         );
         it.built = true;
         self.stats.factorizations += 1;

@@ -127,8 +127,9 @@ where
     }
 
     /// `V`, column by column: q̇ is affine in u̇ at fixed positions, so column k is the change
-    /// of q̇ when u̇_k alone changes, divided by the change (one velocity solve each). The
-    /// change is `1 + |u̇_k|`, so that the difference keeps the digits of a fast motion.
+    /// of q̇ when u̇_k alone changes, divided by the change (one velocity solve each, over the
+    /// factors the solve of `state` archived). The change is `1 + |u̇_k|`, so that the
+    /// difference keeps the digits of a fast motion. `state` must be the solver's last solve.
     ///
     /// # Errors
     /// A velocity solve's error.
@@ -143,7 +144,7 @@ where
             let [u, ud, udd] = x.of(k);
             let change = 1.0 + ud.abs();
             solver.mechanism_mut().set_free(k, [u, ud + change, udd]);
-            let solved = solver.solve_velocity(&state.q, t, &mut self.velocity);
+            let solved = solver.solve_velocity_again(&state.q, t, &mut self.velocity);
             solver.mechanism_mut().set_free(k, [u, ud, udd]);
             solved?;
             let mut column = self.v.column_mut(k);

@@ -74,6 +74,11 @@ where
     pub(super) checked: bool,
     /// The straight step's settings at the length scale, made with the check.
     pub(super) context: StepContext,
+    /// Whether the force solve's archive holds the block factors, and the trig cache the
+    /// sines and cosines, at the positions of the last solve (a full solve of a scene that
+    /// computes forces, through the stage sweep, and no rate solve since): what
+    /// [`Solver::solve_velocity_again`] solves with.
+    pub(super) factors_archived: bool,
 }
 
 /// A copy with its own workspace (to run the same scene on another thread, or to restart
@@ -94,6 +99,7 @@ where
             closed_choices: self.closed_choices,
             checked: self.checked,
             context: self.context,
+            factors_archived: self.factors_archived,
         }
     }
 }
@@ -119,6 +125,7 @@ where
             closed_choices: 0,
             checked: false,
             context: StepContext::new(&options, LengthScale::new(1.0), 0),
+            factors_archived: false,
         }
     }
 
@@ -228,6 +235,7 @@ where
         self.check_len(&state.accelerations)?;
         self.check_len(&state.reactions)?;
         let rates = Rates::of(self.mechanism.outputs());
+        self.factors_archived = false;
         let straight = self.straight_solve(t, state, rates)?;
         let convergence = match straight {
             Some(convergence) => convergence,
@@ -243,6 +251,8 @@ where
                 }),
             )?,
         };
+        // The sweep archives the factors for the force solve (the straight step has none).
+        self.factors_archived = straight.is_none() && rates == Rates::Forces;
         state.t = t;
         state.iterations = convergence.iterations;
         state.condition = convergence.condition;
@@ -275,6 +285,7 @@ where
         t: f64,
     ) -> Result<Convergence, SolveError> {
         let (mut qd, mut qdd) = (q.clone(), q.clone());
+        self.factors_archived = false;
         self.solve_stages(t, q, &mut qd, &mut qdd, Rates::None, None)
             .map_err(|e| self.named(e))
     }

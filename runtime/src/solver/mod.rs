@@ -5,11 +5,13 @@
 //! block's factors are all the storage a solve needs.
 //!
 //! One concept per file: the [`Solver`] type and its API (`api.rs`), the stage sweep of a
-//! full solve (`sweep.rs`), the rate solves (`rates.rs`), the diagnosis of a singularity
+//! full solve (`sweep.rs`), the rate solves (`rates.rs`), the velocity solve again over a full
+//! solve's archived factors (`archived.rs`), the diagnosis of a singularity
 //! (`diagnosis.rs`), unit scaling and distances (`scale.rs`), the checks of inputs and results
 //! (`checks.rs`) and the report of a position solve (`convergence.rs`).
 
 mod api;
+mod archived;
 mod checks;
 mod convergence;
 mod diagnosis;

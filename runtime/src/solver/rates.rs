@@ -33,6 +33,8 @@ where
         rates: Rates,
     ) -> Result<(), SolveError> {
         self.check_mechanism(t)?;
+        // The trig cache is refilled at these positions: the archive's solve no longer has its.
+        self.factors_archived = false;
         let mut reached = 0;
         self.rate_sweep(t, q, qd, qdd, rates, &mut reached)
             .map_err(|e| origin::trace(&self.mechanism, reached, [q, qd, qdd], rates, e))

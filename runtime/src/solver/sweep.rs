@@ -77,9 +77,7 @@ where
             length,
             diagnosed,
             escape_side,
-            closed_choices: _,
-            checked: _,
-            context: _,
+            ..
         } = self;
         let mut parts = workspace.parts();
         let mut total = Convergence::start(options.estimate_condition);
