@@ -98,7 +98,14 @@ impl Dispatch {
             }
             arms => {
                 let arms = merged(arms).into_iter().map(|(stages, statements)| {
-                    let stages = stages.into_iter().map(idx);
+                    let stages = runs(&stages).into_iter().map(|(first, last)| {
+                        let (a, b) = (idx(first), idx(last));
+                        if first == last {
+                            quote!(#a)
+                        } else {
+                            quote!(#a..=#b)
+                        }
+                    });
                     quote! { #(#stages)|* => { #statements } }
                 });
                 let fallback = fallback.unwrap_or_else(|| quote!({}));
@@ -131,6 +138,19 @@ fn merged(arms: &[(usize, TokenStream)]) -> Vec<(Vec<usize>, &TokenStream)> {
         }
     }
     merged
+}
+
+/// Ascending `stages` as runs of consecutive stages, `(first, last)` each: an arm's pattern
+/// names a run as a range (`4..=6`, not `4 | 5 | 6`).
+fn runs(stages: &[usize]) -> Vec<(usize, usize)> {
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for &s in stages {
+        match runs.last_mut() {
+            Some((_, last)) if *last + 1 == s => *last = s,
+            _ => runs.push((s, s)),
+        }
+    }
+    runs
 }
 
 #[cfg(test)]
@@ -213,7 +233,7 @@ mod tests {
         let code = render(&shared, false);
         assert!(
             code.contains(
-                "match stage { 2 | 5 | 6 => { Self :: solve_1 (values , x) ; } \
+                "match stage { 2 | 5 ..= 6 => { Self :: solve_1 (values , x) ; } \
                  3 => { Self :: solve_0 (values , x) ; } _ => { } }"
             ),
             "{code}"
