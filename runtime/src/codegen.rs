@@ -6,7 +6,7 @@
 //! solver's scratch storage ([`Workspace`] and its implementations, with the [`Parts`] it
 //! lends), the checks a scene's generated `check_geometry`, `check_physics` and `load_fault`
 //! call, the context, checks and report of a scene's straight kinematic step ([`StepContext`],
-//! [`choose`]), and the elementary functions generated expressions use ([`math`]). Generated code
+//! [`StepContext::choose`]), and the elementary functions generated expressions use ([`math`]). Generated code
 //! names these by absolute paths (`::mechgen_runtime::codegen::Buffers`); they change with the
 //! code generator, not with the user-facing API at the crate's root.
 

@@ -19,7 +19,8 @@ pub trait Workspace {
     /// buffer.
     fn diagnosis(&self) -> (&[usize], &[usize]);
 
-    /// The trig cache alone ([`Parts::trig`]), for the straight step, which needs nothing else.
+    /// The trig cache alone (the `trig` of [`Parts`]), for the straight step, which needs
+    /// nothing else.
     fn trig(&mut self) -> &mut [f64] {
         self.parts().trig
     }

@@ -4,9 +4,10 @@
 //! stage sweep applies to that block's Newton start.
 //!
 //! The generated step runs every stage in the sweep's order with the scene's kernels called
-//! directly. A block takes its closed-form solution nearest the guess ([`choose`], the rule
-//! of the sweep's closed-form start), its unit-scaled Jacobian is factored with the static
-//! pivots under the same thresholds ([`StepContext::scale_jacobian`]), and the solution must
+//! directly. A block takes its closed-form solution nearest the guess
+//! ([`StepContext::choose`], the rule of the sweep's closed-form start), its unit-scaled
+//! Jacobian is factored with the static pivots under the same thresholds
+//! ([`StepContext::scale_jacobian`]), and the solution must
 //! pass what Newton's first iteration from it would check ([`StepContext::accept`]): a
 //! residual within the tolerances, a Newton correction within the step tolerance (so the
 //! sweep would stop there), and the condition limit; the whole solution passes the sweep's end
