@@ -318,7 +318,7 @@ where
         }
         // From here `next` no longer holds the previous state, whatever the outcome.
         self.has_previous = false;
-        if let Err(error) = self.solver.solve_into(t, next) {
+        if let Err(error) = self.solver.solve_predicted(t, next) {
             return Outcome::Failed(error);
         }
         if predicted && !accept_jump {

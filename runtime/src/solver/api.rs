@@ -81,6 +81,14 @@ where
     pub(super) factors_archived: bool,
 }
 
+/// Where a full solve's guess comes from: the caller (checked, as documented), or
+/// `Simulation`'s prediction from its own solved states (see [`Solver::solve_predicted`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Guess {
+    Given,
+    Predicted,
+}
+
 /// A copy with its own workspace (to run the same scene on another thread, or to restart
 /// from a checkpoint).
 impl<M: Structured + Clone> Clone for Solver<M>
@@ -226,17 +234,36 @@ where
     /// # Errors
     /// Any [`SolveError`] of the position, velocity, acceleration or force solve.
     pub fn solve_into(&mut self, t: f64, state: &mut State<M>) -> Result<(), SolveError> {
-        self.solve_state(t, state).map_err(|e| self.named(e))
+        self.solve_state(t, state, Guess::Given)
+            .map_err(|e| self.named(e))
+    }
+
+    /// [`Solver::solve_into`] from a guess `Simulation` predicted from its own solved states:
+    /// the straight step does not check it first (a non-finite prediction of a block's
+    /// coordinate makes it decline, and the stage sweep then checks and reports it; the
+    /// others are assigned, not read).
+    pub(crate) fn solve_predicted(
+        &mut self,
+        t: f64,
+        state: &mut State<M>,
+    ) -> Result<(), SolveError> {
+        self.solve_state(t, state, Guess::Predicted)
+            .map_err(|e| self.named(e))
     }
 
     /// [`Solver::solve_into`], with unnamed errors.
-    fn solve_state(&mut self, t: f64, state: &mut State<M>) -> Result<(), SolveError> {
+    fn solve_state(
+        &mut self,
+        t: f64,
+        state: &mut State<M>,
+        guess: Guess,
+    ) -> Result<(), SolveError> {
         self.check_len(&state.velocities)?;
         self.check_len(&state.accelerations)?;
         self.check_len(&state.reactions)?;
         let rates = Rates::of(self.mechanism.outputs());
         self.factors_archived = false;
-        let straight = self.straight_solve(t, state, rates)?;
+        let straight = self.straight_solve(t, state, rates, guess)?;
         let convergence = match straight {
             Some(convergence) => convergence,
             None => self.solve_stages(

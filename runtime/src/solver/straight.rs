@@ -5,11 +5,11 @@
 
 use nalgebra::DefaultAllocator;
 
-use super::api::Solver;
+use super::api::{Guess, Solver};
 use super::convergence::Convergence;
 
 use crate::error::{Quantity, SolveError};
-use crate::finite::all_finite;
+use crate::finite::{all_finite, non_finite};
 use crate::mechanism::Storage;
 use crate::options::Rates;
 use crate::state::State;
@@ -29,19 +29,25 @@ where
     /// from the same positions).
     ///
     /// # Errors
-    /// The sweep's input checks: a non-finite `t` or guess, an invalid parameter.
+    /// The sweep's input checks: a non-finite `t` or, when [`Guess::Given`], guess; an invalid
+    /// parameter.
     pub(super) fn straight_solve(
         &mut self,
         t: f64,
         state: &mut State<M>,
         rates: Rates,
+        guess: Guess,
     ) -> Result<Option<Convergence>, SolveError> {
         let options = &self.options;
         let enabled = options.straight_step && options.closed_forms && options.static_pivots;
         if !(enabled && rates == Rates::Both) {
             return Ok(None);
         }
-        self.check_inputs(t, &state.q, Quantity::Guess)?;
+        match guess {
+            Guess::Given => self.check_inputs(t, &state.q, Quantity::Guess)?,
+            Guess::Predicted if !t.is_finite() => return Err(non_finite(t, Quantity::Time)),
+            Guess::Predicted => {}
+        }
         self.check_mechanism(t)?;
         let context = StepContext {
             choices: self.closed_choices,
