@@ -21,12 +21,14 @@ const JUMP_FRACTION: f64 = 0.5;
 /// that a mechanism at rest, whose predicted motion is zero, is not suspect for the corrections
 /// of round-off or of a loosely converged solve.
 const JUMP_FLOOR: f64 = 1e-6;
-/// A predicted step is also suspect when the prediction moves a block coordinate by more than
-/// this (scaled: scene lengths, radians), however close Newton lands to it: over so long a
-/// step the Taylor prediction says nothing about which turn of a lever or which side of a
-/// crank the motion reaches, so a solution near it may be another winding of the same pose
-/// (a single step of 20 rad of crank gave a lever four turns ahead). It is the solver's
-/// default step clamp: no single Newton step moves further either.
+/// A predicted step is also suspect when the prediction turns a block angle by more than this
+/// (radians), however close Newton lands to it: over so long a step the Taylor prediction
+/// says nothing about which turn of a lever or which side of a crank the motion reaches, so a
+/// solution near it may be another winding of the same pose (a single step of 20 rad of crank
+/// gave a lever four turns ahead). It is the solver's default step clamp: no single Newton
+/// step moves further either. Lengths are not bounded: a tall linkage's upper bodies travel
+/// many scene lengths in a step while each joint turns a little (the 1000-stage scissor
+/// lift's platform), and bounding them sub-stepped its rise in proportion to its height.
 const MAX_PREDICTED_MOTION: f64 = 1.0;
 /// Default number of times a failed step may be halved; see [`Simulation::set_max_halvings`].
 pub const DEFAULT_MAX_HALVINGS: u32 = 10;
@@ -322,12 +324,12 @@ where
             return Outcome::Failed(error);
         }
         if predicted && !accept_jump {
-            let (motion, correction) =
+            let (motion, correction, turn) =
                 self.solver
                     .block_distances(&current.q, &self.prediction, &next.q);
             let options = self.solver.options();
             let floor = JUMP_FLOOR + 10.0 * (options.residual_tolerance + options.step_tolerance);
-            if correction > JUMP_FRACTION * motion + floor || motion > MAX_PREDICTED_MOTION {
+            if correction > JUMP_FRACTION * motion + floor || turn > MAX_PREDICTED_MOTION {
                 return Outcome::Jumped;
             }
         }

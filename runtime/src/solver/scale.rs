@@ -21,20 +21,21 @@ where
     /// [`Solver::scaled_distance`] from `prediction` to `previous` and to `solved` (the
     /// motion predicted and the correction Newton made), over the coordinates of the Newton
     /// blocks only: those on which a solve can choose a branch (explicit assignments have one
-    /// solution), so where a jump to another branch shows.
+    /// solution), so where a jump to another branch shows; and the largest predicted turn of
+    /// a block angle (radians).
     pub(crate) fn block_distances(
         &self,
         previous: &Vector<M::Dim>,
         prediction: &Vector<M::Dim>,
         solved: &Vector<M::Dim>,
-    ) -> (f64, f64) {
+    ) -> (f64, f64, f64) {
         let m = &self.mechanism;
         let (previous, prediction, solved) = (
             previous.as_slice(),
             prediction.as_slice(),
             solved.as_slice(),
         );
-        let (mut motion, mut correction) = (0.0, 0.0);
+        let (mut motion, mut correction, mut turn) = (0.0, 0.0, 0.0);
         for s in 0..m.stage_count() {
             let Some(Stage::Block(block)) = m.stage(s) else {
                 continue;
@@ -45,12 +46,16 @@ where
                 else {
                     continue;
                 };
-                let power = self.length.inverse_of(m.coordinate_unit(j));
-                motion = larger(motion, ((x - p) * power).abs());
-                correction = larger(correction, ((x - s) * power).abs());
+                let unit = m.coordinate_unit(j);
+                let moved = ((x - p) * self.length.inverse_of(unit)).abs();
+                motion = larger(motion, moved);
+                if unit == Unit::Angle {
+                    turn = larger(turn, moved);
+                }
+                correction = larger(correction, ((x - s) * self.length.inverse_of(unit)).abs());
             }
         }
-        (motion, correction)
+        (motion, correction, turn)
     }
 
     fn distance_over(
