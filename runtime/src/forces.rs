@@ -156,8 +156,6 @@ where
     DefaultAllocator: Storage<M::Dim>,
 {
     let Motion { t, q, qd, qdd } = *motion;
-    // The first block in reverse is the forward sweep's last: its scales are still set.
-    let mut scaled = true;
     for s in (0..m.stage_count()).rev() {
         match m.stage(s) {
             Some(Stage::Explicit { .. }) => {
@@ -167,9 +165,7 @@ where
                 let bs = BlockSolve { m, stage: s, block };
                 let slots = block.slots;
                 end = end.saturating_sub(slots);
-                if !core::mem::replace(&mut scaled, false) {
-                    bs.set_scales(&mut parts.scales, length);
-                }
+                bs.set_scales(&mut parts.scales, length);
                 let stored =
                     parts.archived.get(s).copied().unwrap_or(false) && archive.len() >= end + slots;
                 let factors = if stored {

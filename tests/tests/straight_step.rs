@@ -2,10 +2,11 @@
 //! default) against the stage sweep it replaces: the same motion over a revolution of every
 //! example scene that has one, the seed against its written-out closed form, and, wherever the
 //! step declines (guesses far from the solution, a toggle, a loop that cannot close), exactly
-//! the sweep's answers and errors.
+//! the sweep's answers and errors; for a scene that computes forces, the reactions of its
+//! archived factors as the sweep's.
 
 use mechgen_examples::closed_form;
-use mechgen_examples::scenes::{FourBar, Hoeken, PistonCrank, QuickReturn};
+use mechgen_examples::scenes::{FourBar, Hoeken, PistonCrank, PistonCrankDynamics, QuickReturn};
 use mechgen_examples::stability::{SliderCrank, Unclosable};
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{
@@ -97,6 +98,37 @@ fn every_scene_with_a_straight_step_follows_the_sweep_and_newton_over_a_revoluti
         let quick_return = QuickReturn::default();
         let period = core::f64::consts::TAU / quick_return.omega;
         agrees_over(quick_return, reference, 2.0 * period, 720, 2, 1e-13);
+    }
+}
+
+#[test]
+fn a_scene_that_computes_forces_takes_the_straight_step_with_the_sweeps_reactions() {
+    let scene = PistonCrankDynamics::default();
+    let period = core::f64::consts::TAU / scene.omega;
+    let start = |options| {
+        Simulation::new(Solver::with_options(scene, options), 0.0)
+            .unwrap_or_else(|e| panic!("assembles: {e}"))
+    };
+    let (mut straight, mut swept) = (start(SolverOptions::default()), start(sweep()));
+    for i in 1..=360 {
+        let t = period * f64::from(i) / 360.0;
+        let a = straight.step_to(t).unwrap_or_else(|e| panic!("t {t}: {e}"));
+        let b = swept.step_to(t).unwrap_or_else(|e| panic!("t {t}: {e}"));
+        assert_eq!(
+            (a.iterations, a.closed_forms),
+            (0, 1),
+            "t {t}: not a straight step"
+        );
+        assert!(
+            b.iterations > 0,
+            "t {t}: the reference took no Newton iteration"
+        );
+        let errors = levels(a, b);
+        assert!(errors.iter().all(|&e| e < 1e-13), "t {t}: {errors:?}");
+        let (r, reference) = (a.constraint_forces(), b.constraint_forces());
+        let scale = reference.amax();
+        let error = (r - reference).amax() / scale;
+        assert!(error < 1e-12, "t {t}: reactions {error:e} off the sweep's");
     }
 }
 

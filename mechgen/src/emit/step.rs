@@ -1,10 +1,12 @@
 //! The straight kinematic step as code: for a scene whose every block has a closed form and
-//! whose outputs are the accelerations (no forces), `Structured::straight_step`, one function that runs the stages
-//! in the sweep's order by calling their kernels directly (no dispatch on the stage index),
-//! with the trig cache viewed as its array once. Each block takes its closed-form solution
-//! under the runtime's checks (`::mechgen_runtime::codegen::{choose, StepContext}`), factors
-//! its Jacobian with its static LU and solves its rates with those factors. A failed check
-//! restores the guess and returns the stage: the solver then runs the stage sweep.
+//! whose outputs are the accelerations or the forces, `Structured::straight_step`, one
+//! function that runs the stages in the sweep's order by calling their kernels directly (no
+//! dispatch on the stage index), with the trig cache viewed as its array once. Each block
+//! takes its closed-form solution under the runtime's checks
+//! (`::mechgen_runtime::codegen::{choose, StepContext}`), factors its Jacobian with its static
+//! LU and solves its rates with those factors; a scene that computes forces also archives
+//! the factors for the runtime's force solve (in the sweep's layout). A failed check restores
+//! the guess and returns the stage: the solver then runs the stage sweep.
 
 use proc_macro2::{Ident, Literal, TokenStream};
 use quote::{format_ident, quote};
@@ -25,9 +27,8 @@ pub(super) fn straight_step(
     kernels: &Kernels,
     functions: &[(TokenStream, Kernel)],
 ) -> Option<(TokenStream, TokenStream)> {
-    // The solver takes the step for a full kinematic solve only (a force solve needs the
-    // factors archived the sweep's way; fewer outputs keep the sweep).
-    if cx.model.outputs != Outputs::Accelerations {
+    // The solver takes the step for a full solve only (fewer outputs keep the sweep).
+    if cx.model.outputs < Outputs::Accelerations {
         return None;
     }
     let functions: Vec<&Kernel> = functions.iter().map(|(_, f)| f).collect();
@@ -56,6 +57,9 @@ impl Stages {
             variants: Vec::new(),
             blocks: false,
         };
+        // Where each block's factors go in the force solve's archive (stage order, as the
+        // sweep archives them), for a scene that computes forces.
+        let mut archived = (cx.model.outputs == Outputs::Forces).then_some(0);
         for (s, shape) in kernels.shapes.iter().enumerate() {
             let mut calls = StageCalls::of(kernels, functions, s);
             stages.code.push(match &shape.block {
@@ -69,7 +73,14 @@ impl Stages {
                         calls.replace(Method::Jacobian, kernel.call());
                     }
                     let factorization = block.factorization?;
-                    block_step(kernels, s, &calls, &units, factorization, trig_first)?
+                    let archive = archived.map(|start| start..start + block.slots);
+                    archived = archive.as_ref().map(|slots| slots.end);
+                    let block = BlockStep {
+                        factorization,
+                        trig_first,
+                        archive,
+                    };
+                    block_step(kernels, s, &calls, &units, block)?
                 }
             });
         }
@@ -77,7 +88,7 @@ impl Stages {
     }
 
     /// `straight_stages`, the inherent function that runs them, then the end checks; and the
-    /// Jacobian variants. Parameters no kernel reads are named `_t`, `_report`.
+    /// Jacobian variants. Parameters no kernel reads are named `_t`, `_report`, `_archive`.
     fn function(&self, cx: &Context<'_>, kernels: &Kernels, functions: &[&Kernel]) -> TokenStream {
         let reads = |name: &str| functions.iter().any(|f| f.arguments.contains(&name));
         let unused = |used: bool, name: &str| {
@@ -89,6 +100,8 @@ impl Stages {
             format_ident!("{}", name)
         };
         let (t, report) = (unused(reads("t"), "t"), unused(self.blocks, "report"));
+        let forces = cx.model.outputs == Outputs::Forces;
+        let archive = unused(self.blocks && forces, "archive");
         let trig_len = idx(kernels.sizes.trig);
         let view = reads("trig").then(|| {
             quote! {
@@ -117,6 +130,7 @@ impl Stages {
                 qd: &mut #vector,
                 qdd: &mut #vector,
                 trig_cache: &mut [f64],
+                #archive: &mut [f64],
                 context: &::mechgen_runtime::codegen::StepContext,
                 #report: &mut ::mechgen_runtime::codegen::StepReport,
             ) -> ::core::result::Result<(), usize> {
@@ -197,12 +211,13 @@ fn trait_method() -> TokenStream {
             qd: &mut #vector,
             qdd: &mut #vector,
             trig: &mut [f64],
+            archive: &mut [f64],
             context: &::mechgen_runtime::codegen::StepContext,
             report: &mut ::mechgen_runtime::codegen::StepReport,
         ) -> ::core::result::Result<(), usize> {
             // The sweep that runs where the step fails checks and reads the guess as given.
             let guess = *q;
-            let result = self.straight_stages(t, q, qd, qdd, trig, context, report);
+            let result = self.straight_stages(t, q, qd, qdd, trig, archive, context, report);
             if result.is_err() {
                 *q = guess;
             }
@@ -288,9 +303,19 @@ fn solved_jacobian(cx: &Context<'_>, kernels: &Kernels, s: usize) -> Option<(Tok
     Some(named_kernel_function(cx, kernels, &solved, naming))
 }
 
+/// How a block's step is made.
+struct BlockStep {
+    /// The block's static LU (`factor_k`, `solve_k`).
+    factorization: usize,
+    /// Whether the trig cache is filled from the choice before the Jacobian, which reads it.
+    trig_first: bool,
+    /// Where its factors go in the force solve's archive, for a scene that computes forces.
+    archive: Option<core::ops::Range<usize>>,
+}
+
 /// A block's part of the step: candidates → choice → (trig from the choice's unit vectors,
 /// when the Jacobian reads it) → Jacobian and Φ at the choice → scaled factors → checks →
-/// (trig) → rates by the static LU.
+/// (archived factors) → (trig) → rates by the static LU.
 /// `None` for a block without a closed form.
 // Kept whole: most of it is the block's template, which reads best in one piece.
 fn block_step(
@@ -298,9 +323,13 @@ fn block_step(
     s: usize,
     calls: &StageCalls,
     units: &Units<'_>,
-    factorization: usize,
-    trig_first: bool,
+    step: BlockStep,
 ) -> Option<TokenStream> {
+    let BlockStep {
+        factorization,
+        trig_first,
+        archive,
+    } = step;
     let shape = &kernels.shapes[s];
     let block = shape.block.as_ref()?;
     if !calls.calls.iter().any(|(m, _)| *m == Method::ClosedForm) {
@@ -345,6 +374,15 @@ fn block_step(
     } else {
         (TokenStream::new(), trig)
     };
+    let archive = archive.map(|slots| {
+        let (start, end) = (idx(slots.start), idx(slots.end));
+        quote! {
+            let ::core::option::Option::Some(kept) = archive.get_mut(#start..#end) else {
+                return ::core::result::Result::Err(#stage);
+            };
+            kept.copy_from_slice(values);
+        }
+    });
     let scatter = |target: TokenStream| quote!(#(#target[#coordinates] = x[#locals];)*);
     let (to_q, to_qd, to_qdd) = (
         scatter(quote!(q)),
@@ -375,6 +413,7 @@ fn block_step(
             let values = &*values;
             let solve = |x: &mut [f64; #n_lit]| Self::#solve(values, x);
             context.accept(#stage, phi, &x, &scales, &[#(values[#pivots]),*], norm1, solve, report)?;
+            #archive
             #trig_after
             let out = &mut [0.0_f64; #n_lit];
             #velocity_rhs

@@ -278,8 +278,8 @@ where
                 }),
             )?,
         };
-        // The sweep archives the factors for the force solve (the straight step has none).
-        self.factors_archived = straight.is_none() && rates == Rates::Forces;
+        // Both paths archive the blocks' factors for the force solve.
+        self.factors_archived = rates == Rates::Forces;
         state.t = t;
         state.iterations = convergence.iterations;
         state.condition = convergence.condition;

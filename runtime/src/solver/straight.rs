@@ -10,6 +10,7 @@ use super::convergence::Convergence;
 
 use crate::error::{Quantity, SolveError};
 use crate::finite::{all_finite, non_finite};
+use crate::forces;
 use crate::mechanism::Storage;
 use crate::options::Rates;
 use crate::state::State;
@@ -23,10 +24,10 @@ where
 {
     /// Solves `state` at `t` by the straight step: `Ok(Some(convergence))` when it did,
     /// `Ok(None)` when the stage sweep must (no straight step; it, closed forms or static
-    /// pivots switched off; forces or fewer rates asked for; a check declined). The guess is
-    /// then as it was, or, past a declined end check, the step's positions, from which every
-    /// block takes the same closed-form solution (non-finite markers, which the sweep reports
-    /// from the same positions).
+    /// pivots switched off; fewer rates than both asked for; a check or the force solve
+    /// declined). The guess is then as it was, or, past a declined end check, the step's
+    /// positions, from which every block takes the same closed-form solution (non-finite
+    /// markers or multipliers, which the sweep reports from the same positions).
     ///
     /// # Errors
     /// The sweep's input checks: a non-finite `t` or, when [`Guess::Given`], guess; an invalid
@@ -40,7 +41,7 @@ where
     ) -> Result<Option<Convergence>, SolveError> {
         let options = &self.options;
         let enabled = options.straight_step && options.closed_forms && options.static_pivots;
-        if !(enabled && rates == Rates::Both) {
+        if !(enabled && matches!(rates, Rates::Both | Rates::Forces)) {
             return Ok(None);
         }
         match guess {
@@ -54,24 +55,22 @@ where
             ..self.context
         };
         let mut report = StepReport::new(context.estimate_condition);
-        let m = &self.mechanism;
-        let trig = self.workspace.trig();
-        let (q, qd, qdd) = (
-            &mut state.q,
-            &mut state.velocities,
-            &mut state.accelerations,
-        );
-        if m.straight_step(t, q, qd, qdd, trig, &context, &mut report)
-            .is_err()
-        {
+        let done = if rates == Rates::Forces {
+            self.straight_forces(t, state, &context, &mut report)
+        } else {
+            let trig = self.workspace.trig();
+            let (q, qd, qdd) = (
+                &mut state.q,
+                &mut state.velocities,
+                &mut state.accelerations,
+            );
+            let m = &self.mechanism;
+            m.straight_step(t, q, qd, qdd, trig, &mut [], &context, &mut report)
+                .is_ok()
+                && markers(m, t, state, self.workspace.trig())
+        };
+        if !done {
             return Ok(None);
-        }
-        // The step made the sweep's end checks (`StepContext::check_end`) but the markers'.
-        if !state.markers.as_ref().is_empty() {
-            m.markers(q, trig, qd, qdd, t, &mut state.markers);
-            if !all_finite(state.markers.as_ref()) {
-                return Ok(None);
-            }
         }
         self.diagnosed = (0, 0);
         self.closed_choices = report.choices;
@@ -87,4 +86,61 @@ where
             closed_forms: report.blocks,
         }))
     }
+
+    /// The straight step of a scene that computes forces: the step, with every block's
+    /// factors archived as the sweep archives them, then the force solve over them and the
+    /// markers; whether all of it succeeded (a failed force solve leaves the sweep to name
+    /// its error).
+    fn straight_forces(
+        &mut self,
+        t: f64,
+        state: &mut State<M>,
+        context: &StepContext,
+        report: &mut StepReport,
+    ) -> bool {
+        let Self {
+            mechanism: m,
+            workspace,
+            options,
+            length,
+            ..
+        } = self;
+        let mut parts = workspace.parts();
+        let n = state.q.len();
+        let Some(archive) = parts.forces.get_mut(n..) else {
+            return false;
+        };
+        // The generated workspace holds exactly the multipliers and every block's factors.
+        let archived = archive.len();
+        let (q, qd, qdd) = (
+            &mut state.q,
+            &mut state.velocities,
+            &mut state.accelerations,
+        );
+        if m.straight_step(t, q, qd, qdd, parts.trig, archive, context, report)
+            .is_err()
+        {
+            return false;
+        }
+        // Every block of a straight step is factored with its static pivots.
+        parts.archived.fill(true);
+        let motion = forces::Motion { t, q, qd, qdd };
+        let reactions = &mut state.reactions;
+        forces::solve(m, &mut parts, options, length, &motion, archived, reactions).is_ok()
+            && markers(m, t, state, parts.trig)
+    }
+}
+
+/// The markers at the step's solved state, which the step's own end checks leave out;
+/// whether they are finite (the sweep reports them otherwise).
+fn markers<M: Structured>(m: &M, t: f64, state: &mut State<M>, trig: &[f64]) -> bool
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    if state.markers.as_ref().is_empty() {
+        return true;
+    }
+    let (q, qd, qdd) = (&state.q, &state.velocities, &state.accelerations);
+    m.markers(q, trig, qd, qdd, t, &mut state.markers);
+    all_finite(state.markers.as_ref())
 }
