@@ -183,11 +183,12 @@ where
     /// accelerations at `t`, each block taking its closed-form solution nearest the guess in
     /// `q` after the checks of [`crate::codegen::StepContext`], and the trig cache filled as
     /// the stage sweep fills it. Generated for a scene whose every block has a closed form
-    /// and whose outputs are the accelerations or the forces. For the force solve, each
-    /// block's static factors are written into `archive` (the force storage past the
-    /// multipliers, in stage order, as the stage sweep archives them; empty for a kinematic
-    /// scene). `Err(stage)` where a check fails (or, by default, for a scene without one),
-    /// with `q` as it was: the solver then runs the stage sweep.
+    /// and whose outputs are the accelerations or the forces. A scene that computes forces
+    /// ends with the force solve, into `forces` (the workspace's force storage, empty for a
+    /// kinematic scene): the multipliers, then each block's static factors, archived in stage
+    /// order as the stage sweep archives them. `Err(stage)` where a check fails (or, by
+    /// default, for a scene without one), with `q` as it was: the solver then runs the stage
+    /// sweep.
     #[allow(clippy::too_many_arguments)]
     fn straight_step(
         &self,
@@ -196,7 +197,7 @@ where
         _qd: &mut Vector<Self::Dim>,
         _qdd: &mut Vector<Self::Dim>,
         _trig: &mut [f64],
-        _archive: &mut [f64],
+        _forces: &mut [f64],
         _context: &StepContext,
         _report: &mut StepReport,
     ) -> Result<(), usize> {

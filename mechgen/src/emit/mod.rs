@@ -18,6 +18,7 @@ mod motion;
 mod plan;
 mod stages;
 mod step;
+mod step_forces;
 
 use std::cell::RefCell;
 use std::collections::HashMap;

@@ -14,9 +14,10 @@ use quote::{format_ident, quote};
 use super::body::Context;
 use super::idx;
 use super::plan::{Kernel, named_kernel_function};
+use super::step_forces::{ForceSolve, archive_ranges, straight_forces};
 use crate::expr::Id;
 use crate::model::{Outputs, Unit};
-use crate::plan::kernels::{Buffer, Kernels, Method, StageKernel};
+use crate::plan::kernels::{Buffer, Kernels, Method, StageKernel, StageShape};
 use crate::plan::trig::Phase;
 
 /// The straight step of a scene that can have one: the inherent function that runs the
@@ -32,34 +33,33 @@ pub(super) fn straight_step(
         return None;
     }
     let functions: Vec<&Kernel> = functions.iter().map(|(_, f)| f).collect();
-    let stages = Stages::of(cx, kernels, &functions)?;
+    let mut stages = Stages::of(cx, kernels, &functions)?;
+    if cx.model.outputs == Outputs::Forces {
+        stages.forces = Some(straight_forces(cx, kernels, &functions)?);
+    }
     Some((stages.function(cx, kernels, &functions), trait_method()))
 }
 
-/// The step's stages as code, and the Jacobian variants its blocks call.
+/// The step's stages as code, the Jacobian variants its blocks call, and, for a scene that
+/// computes forces, its force solve (`straight_forces`).
 struct Stages {
     code: Vec<TokenStream>,
     variants: Vec<TokenStream>,
     blocks: bool,
+    forces: Option<ForceSolve>,
 }
 
 impl Stages {
     /// Every stage's part of the step; `None` if a block has no closed form or static LU.
     fn of(cx: &Context<'_>, kernels: &Kernels, functions: &[&Kernel]) -> Option<Self> {
-        let (coordinate_units, equation_units) =
-            (cx.model.coordinate_units(), cx.model.equation_units());
-        let units = Units {
-            coordinates: &coordinate_units,
-            equations: &equation_units,
-        };
         let mut stages = Stages {
             code: Vec::new(),
             variants: Vec::new(),
             blocks: false,
+            forces: None,
         };
-        // Where each block's factors go in the force solve's archive (stage order, as the
-        // sweep archives them), for a scene that computes forces.
-        let mut archived = (cx.model.outputs == Outputs::Forces).then_some(0);
+        let forces = cx.model.outputs == Outputs::Forces;
+        let archive = archive_ranges(kernels);
         for (s, shape) in kernels.shapes.iter().enumerate() {
             let mut calls = StageCalls::of(kernels, functions, s);
             stages.code.push(match &shape.block {
@@ -72,15 +72,12 @@ impl Stages {
                         stages.variants.push(function);
                         calls.replace(Method::Jacobian, kernel.call());
                     }
-                    let factorization = block.factorization?;
-                    let archive = archived.map(|start| start..start + block.slots);
-                    archived = archive.as_ref().map(|slots| slots.end);
                     let block = BlockStep {
-                        factorization,
+                        factorization: block.factorization?,
                         trig_first,
-                        archive,
+                        archive: archive[s].clone().filter(|_| forces),
                     };
-                    block_step(kernels, s, &calls, &units, block)?
+                    block_step(cx, kernels, s, &calls, block)?
                 }
             });
         }
@@ -88,7 +85,8 @@ impl Stages {
     }
 
     /// `straight_stages`, the inherent function that runs them, then the end checks; and the
-    /// Jacobian variants. Parameters no kernel reads are named `_t`, `_report`, `_archive`.
+    /// Jacobian variants, and the force solve's function with its call at the end. Parameters
+    /// no kernel reads are named `_t`, `_report`, `_forces`.
     fn function(&self, cx: &Context<'_>, kernels: &Kernels, functions: &[&Kernel]) -> TokenStream {
         let reads = |name: &str| functions.iter().any(|f| f.arguments.contains(&name));
         let unused = |used: bool, name: &str| {
@@ -100,8 +98,36 @@ impl Stages {
             format_ident!("{}", name)
         };
         let (t, report) = (unused(reads("t"), "t"), unused(self.blocks, "report"));
-        let forces = cx.model.outputs == Outputs::Forces;
-        let archive = unused(self.blocks && forces, "archive");
+        let forces = unused(self.forces.is_some(), "forces");
+        let (dim, archived) = (
+            idx(cx.model.dim()),
+            idx(kernels
+                .sizes
+                .forces
+                .unwrap_or(0)
+                .saturating_sub(cx.model.dim())),
+        );
+        // The force storage as the multipliers' and the archive's arrays, and the force solve
+        // after the end checks.
+        let (split, force_solve) = match &self.forces {
+            None => Default::default(),
+            Some(forces) => (
+                quote! {
+                    let ::core::option::Option::Some((lambda, archive)) =
+                        forces.split_first_chunk_mut::<#dim>()
+                    else {
+                        return ::core::result::Result::Err(0);
+                    };
+                    let ::core::option::Option::Some(archive) =
+                        archive.first_chunk_mut::<#archived>()
+                    else {
+                        return ::core::result::Result::Err(0);
+                    };
+                },
+                forces.call.clone(),
+            ),
+        };
+        let force_function = self.forces.as_ref().map(|f| &f.function);
         let trig_len = idx(kernels.sizes.trig);
         let view = reads("trig").then(|| {
             quote! {
@@ -130,18 +156,21 @@ impl Stages {
                 qd: &mut #vector,
                 qdd: &mut #vector,
                 trig_cache: &mut [f64],
-                #archive: &mut [f64],
+                #forces: &mut [f64],
                 context: &::mechgen_runtime::codegen::StepContext,
                 #report: &mut ::mechgen_runtime::codegen::StepReport,
             ) -> ::core::result::Result<(), usize> {
                 #view
+                #split
                 #(#stages)*
                 let end = Self::STAGES.len();
                 context.check_rounding(end, &[#(#lengths),*], &[#(#angles),*])?;
                 context.check_end(end, self, q, &[#(#rates),*], trig_cache)?;
+                #force_solve
                 ::core::result::Result::Ok(())
             }
             #(#variants)*
+            #force_function
         }
     }
 }
@@ -211,13 +240,13 @@ fn trait_method() -> TokenStream {
             qd: &mut #vector,
             qdd: &mut #vector,
             trig: &mut [f64],
-            archive: &mut [f64],
+            forces: &mut [f64],
             context: &::mechgen_runtime::codegen::StepContext,
             report: &mut ::mechgen_runtime::codegen::StepReport,
         ) -> ::core::result::Result<(), usize> {
             // The sweep that runs where the step fails checks and reads the guess as given.
             let guess = *q;
-            let result = self.straight_stages(t, q, qd, qdd, trig, archive, context, report);
+            let result = self.straight_stages(t, q, qd, qdd, trig, forces, context, report);
             if result.is_err() {
                 *q = guess;
             }
@@ -226,20 +255,28 @@ fn trait_method() -> TokenStream {
     }
 }
 
-/// The scene's units, by global index.
-struct Units<'a> {
-    coordinates: &'a [Unit],
-    equations: &'a [Unit],
+/// `context.scales(…)`: a block's row and column scales, from its equations' and
+/// coordinates' units.
+pub(super) fn block_scales(cx: &Context<'_>, shape: &StageShape) -> TokenStream {
+    let unit = |u: Unit| {
+        let variant = format_ident!("{}", u.name());
+        quote!(::mechgen_runtime::Unit::#variant)
+    };
+    let (coordinate_units, equation_units) =
+        (cx.model.coordinate_units(), cx.model.equation_units());
+    let equations = shape.equations.iter().map(|&e| unit(equation_units[e]));
+    let coordinates = shape.coordinates.iter().map(|&c| unit(coordinate_units[c]));
+    quote!(context.scales([#(#equations),*], [#(#coordinates),*]))
 }
 
 /// A stage's kernel calls, by method.
-struct StageCalls {
+pub(super) struct StageCalls {
     calls: Vec<(Method, TokenStream)>,
 }
 
 impl StageCalls {
     /// The calls of stage `s`'s kernels.
-    fn of(kernels: &Kernels, functions: &[&Kernel], s: usize) -> Self {
+    pub(super) fn of(kernels: &Kernels, functions: &[&Kernel], s: usize) -> Self {
         let calls = kernels
             .stages
             .iter()
@@ -260,7 +297,7 @@ impl StageCalls {
     }
 
     /// `call;` for the stage's kernel of `method`, nothing without one.
-    fn call(&self, method: Method) -> TokenStream {
+    pub(super) fn call(&self, method: Method) -> TokenStream {
         let call = self.calls.iter().find(|(m, _)| *m == method);
         call.map(|(_, c)| quote!(#c;)).unwrap_or_default()
     }
@@ -319,10 +356,10 @@ struct BlockStep {
 /// `None` for a block without a closed form.
 // Kept whole: most of it is the block's template, which reads best in one piece.
 fn block_step(
+    cx: &Context<'_>,
     kernels: &Kernels,
     s: usize,
     calls: &StageCalls,
-    units: &Units<'_>,
     step: BlockStep,
 ) -> Option<TokenStream> {
     let BlockStep {
@@ -337,19 +374,12 @@ fn block_step(
     }
     let n = shape.coordinates.len();
     let (stage, n_lit, candidates, slots) = (idx(s), idx(n), idx(4 * n), idx(block.slots));
-    let unit = |u: Unit| {
-        let variant = format_ident!("{}", u.name());
-        quote!(::mechgen_runtime::Unit::#variant)
-    };
-    let equation_units = shape.equations.iter().map(|&e| unit(units.equations[e]));
-    let coordinate_units = shape
-        .coordinates
-        .iter()
-        .map(|&c| unit(units.coordinates[c]));
+    let scales = block_scales(cx, shape);
+    let coordinate_units = cx.model.coordinate_units();
     let angles = shape
         .coordinates
         .iter()
-        .map(|&c| units.coordinates[c] == Unit::Angle);
+        .map(|&c| coordinate_units[c] == Unit::Angle);
     let coordinates: Vec<Literal> = shape.coordinates.iter().map(|&c| idx(c)).collect();
     let locals: Vec<Literal> = (0..n).map(idx).collect();
     let pattern = block.pattern.iter().map(|&(i, j)| {
@@ -376,12 +406,7 @@ fn block_step(
     };
     let archive = archive.map(|slots| {
         let (start, end) = (idx(slots.start), idx(slots.end));
-        quote! {
-            let ::core::option::Option::Some(kept) = archive.get_mut(#start..#end) else {
-                return ::core::result::Result::Err(#stage);
-            };
-            kept.copy_from_slice(values);
-        }
+        quote!(archive[#start..#end].copy_from_slice(values);)
     });
     let scatter = |target: TokenStream| quote!(#(#target[#coordinates] = x[#locals];)*);
     let (to_q, to_qd, to_qdd) = (
@@ -391,7 +416,7 @@ fn block_step(
     );
     Some(quote! {
         {
-            let scales = context.scales([#(#equation_units),*], [#(#coordinate_units),*]);
+            let scales = #scales;
             let out = &mut [0.0_f64; #candidates];
             #closed_form
             let guess = [#(q[#coordinates]),*];

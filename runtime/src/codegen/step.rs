@@ -239,6 +239,27 @@ impl StepContext {
         }
     }
 
+    /// A block's multipliers from its force right-hand side `rhs` (unscaled, column order):
+    /// `J⁻ᵀ rhs`, with `solve_transpose` (`x ← S⁻ᵀ x`) of the block's factors, as the runtime's
+    /// force solve computes them (its one finiteness check, on the reactions, follows).
+    #[inline]
+    pub fn multipliers<const N: usize>(
+        &self,
+        rhs: &[f64; N],
+        scales: &BlockScales<N>,
+        solve_transpose: impl FnOnce(&mut [f64; N]),
+    ) -> [f64; N] {
+        let mut x = [0.0; N];
+        for ((x, &b), &c) in x.iter_mut().zip(rhs).zip(&scales.cols) {
+            *x = b * c;
+        }
+        solve_transpose(&mut x);
+        for (x, &r) in x.iter_mut().zip(&scales.rows) {
+            *x *= r;
+        }
+        x
+    }
+
     /// Whether explicit assignments can be accepted unevaluated at the step's positions (the
     /// sweep's rounding bound, see [`crate::acceptance`]): every scaled coordinate below it.
     /// Above, the sweep's evaluation of the explicit residuals decides. `lengths` and `angles`

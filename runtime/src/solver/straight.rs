@@ -10,7 +10,6 @@ use super::convergence::Convergence;
 
 use crate::error::{Quantity, SolveError};
 use crate::finite::{all_finite, non_finite};
-use crate::forces;
 use crate::mechanism::Storage;
 use crate::options::Rates;
 use crate::state::State;
@@ -24,8 +23,8 @@ where
 {
     /// Solves `state` at `t` by the straight step: `Ok(Some(convergence))` when it did,
     /// `Ok(None)` when the stage sweep must (no straight step; it, closed forms or static
-    /// pivots switched off; fewer rates than both asked for; a check or the force solve
-    /// declined). The guess is then as it was, or, past a declined end check, the step's
+    /// pivots switched off; fewer rates than both asked for; a check declined, or the
+    /// reactions are not finite). The guess is then as it was, or, past a declined end check, the step's
     /// positions, from which every block takes the same closed-form solution (non-finite
     /// markers or multipliers, which the sweep reports from the same positions).
     ///
@@ -87,10 +86,11 @@ where
         }))
     }
 
-    /// The straight step of a scene that computes forces: the step, with every block's
-    /// factors archived as the sweep archives them, then the force solve over them and the
-    /// markers; whether all of it succeeded (a failed force solve leaves the sweep to name
-    /// its error).
+    /// The straight step of a scene that computes forces: the step, which also archives
+    /// every block's factors as the sweep archives them (for the integrator's velocity solves
+    /// over them) and ends with the force solve's multipliers, then the reactions and the
+    /// markers; whether all of it succeeded (non-finite reactions leave the sweep to name
+    /// their cause).
     fn straight_forces(
         &mut self,
         t: f64,
@@ -98,36 +98,24 @@ where
         context: &StepContext,
         report: &mut StepReport,
     ) -> bool {
-        let Self {
-            mechanism: m,
-            workspace,
-            options,
-            length,
-            ..
-        } = self;
-        let mut parts = workspace.parts();
-        let n = state.q.len();
-        let Some(archive) = parts.forces.get_mut(n..) else {
-            return false;
-        };
-        // The generated workspace holds exactly the multipliers and every block's factors.
-        let archived = archive.len();
+        let m = &self.mechanism;
+        let parts = self.workspace.parts();
         let (q, qd, qdd) = (
             &mut state.q,
             &mut state.velocities,
             &mut state.accelerations,
         );
-        if m.straight_step(t, q, qd, qdd, parts.trig, archive, context, report)
+        let forces = &mut *parts.forces;
+        if m.straight_step(t, q, qd, qdd, parts.trig, forces, context, report)
             .is_err()
         {
             return false;
         }
         // Every block of a straight step is factored with its static pivots.
         parts.archived.fill(true);
-        let motion = forces::Motion { t, q, qd, qdd };
-        let reactions = &mut state.reactions;
-        forces::solve(m, &mut parts, options, length, &motion, archived, reactions).is_ok()
-            && markers(m, t, state, parts.trig)
+        let lambda = parts.forces.get(..q.len()).unwrap_or_default();
+        m.reactions(q, qd, lambda, &mut state.reactions);
+        all_finite(state.reactions.as_slice()) && markers(m, t, state, parts.trig)
     }
 }
 

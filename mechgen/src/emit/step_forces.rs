@@ -1,0 +1,138 @@
+//! The straight step's force solve as code, for a scene that computes forces: the stages in
+//! reverse, as the runtime's force solve (`forces.rs`) runs them, with their kernels called
+//! directly (no dispatch on the stage index). An explicit stage assigns its multipliers in
+//! closed form; a block solves `Φ_q[b, b]ᵀ λ_b = F_b − Φ_q[later, b]ᵀ λ_later` with the
+//! static factors the forward step archived (`StepContext::multipliers`). The runtime then
+//! turns the multipliers into reactions and checks them once.
+
+use core::ops::Range;
+
+use proc_macro2::{Ident, Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::body::Context;
+use super::idx;
+use super::plan::Kernel;
+use super::step::{StageCalls, block_scales};
+use crate::plan::kernels::{Kernels, Method};
+
+/// Where each stage's factors go in the force solve's archive (after the multipliers): a
+/// block's slots in stage order, as the runtime's sweep archives them; `None` for an
+/// explicit stage.
+pub(super) fn archive_ranges(kernels: &Kernels) -> Vec<Option<Range<usize>>> {
+    let mut end = 0;
+    let ranges = kernels.shapes.iter().map(|shape| {
+        let slots = shape.block.as_ref()?.slots;
+        let range = end..end + slots;
+        end = range.end;
+        Some(range)
+    });
+    ranges.collect()
+}
+
+/// `straight_forces`, the inherent function the straight step ends with: the multipliers of
+/// every stage in reverse into `lambda`, the blocks' factors read from `archive`. `None` when
+/// a block has no static LU (the step then has none either). It takes the motion's
+/// arguments its kernels read.
+pub(super) fn straight_forces(
+    cx: &Context<'_>,
+    kernels: &Kernels,
+    functions: &[&Kernel],
+) -> Option<ForceSolve> {
+    let ranges = archive_ranges(kernels);
+    let mut code = Vec::new();
+    for (s, shape) in kernels.shapes.iter().enumerate().rev() {
+        let calls = StageCalls::of(kernels, functions, s);
+        let Some(block) = &shape.block else {
+            code.push(calls.call(Method::Multipliers));
+            continue;
+        };
+        let (stage, slots) = (idx(s), idx(block.slots));
+        let start = idx(ranges[s].as_ref()?.start);
+        let n = idx(shape.coordinates.len());
+        let solve_transpose = format_ident!("solve_transpose_{}", block.factorization?);
+        let scales = block_scales(cx, shape);
+        let force_rhs = calls.call(Method::ForceRhs);
+        let equations = shape.equations.iter().map(|&e| idx(e));
+        let locals = (0..shape.equations.len()).map(idx);
+        code.push(quote! {
+            {
+                let ::core::option::Option::Some(values) = archive[#start..].first_chunk::<#slots>()
+                else {
+                    return ::core::result::Result::Err(#stage);
+                };
+                let scales = #scales;
+                let out = &mut [0.0_f64; #n];
+                #force_rhs
+                let x = context.multipliers(out, &scales, |x| Self::#solve_transpose(values, x));
+                #(lambda[#equations] = x[#locals];)*
+            }
+        });
+    }
+    let blocks = ranges.iter().any(Option::is_some);
+    let force_kernels: Vec<&Kernel> = kernels
+        .stages
+        .iter()
+        .zip(functions)
+        .filter(|(k, _)| matches!(k.method, Method::Multipliers | Method::ForceRhs))
+        .map(|(_, &f)| f)
+        .collect();
+    let reads = |name: &str| force_kernels.iter().any(|f| f.arguments.contains(&name));
+    let named = |used: bool, name: &str| format_ident!("{}{}", if used { "" } else { "_" }, name);
+    // The motion's arguments the kernels read, in the caller's order.
+    let vector = cx.vector_type();
+    let motion: Vec<(Ident, TokenStream)> = [("t", quote!(f64)), ("q", quote!(&#vector))]
+        .into_iter()
+        .chain(["qd", "qdd"].map(|name| (name, quote!(&#vector))))
+        .filter(|(name, _)| reads(name))
+        .map(|(name, ty)| (format_ident!("{}", name), ty))
+        .collect();
+    // The trig cache is viewed as its array again: the step's end checks read it whole.
+    let trig_len = idx(kernels.sizes.trig);
+    let (trig_cache, view) = match reads("trig") {
+        false => (format_ident!("_trig_cache"), TokenStream::new()),
+        true => (
+            format_ident!("trig_cache"),
+            quote! {
+                let ::core::option::Option::Some(trig) = trig_cache.first_chunk::<#trig_len>()
+                else {
+                    return ::core::result::Result::Err(0);
+                };
+            },
+        ),
+    };
+    let (archive, context) = (named(blocks, "archive"), named(blocks, "context"));
+    let (dim, archived): (Literal, Literal) = (
+        idx(cx.model.dim()),
+        idx(ranges.iter().flatten().map(|r| r.len()).sum()),
+    );
+    let parameters = motion.iter().map(|(name, ty)| quote!(#name: #ty));
+    let arguments = motion.iter().map(|(name, _)| name);
+    let call = quote! {
+        self.straight_forces(#(#arguments,)* trig_cache, lambda, archive, context)?;
+    };
+    let function = quote! {
+        /// The straight step's force solve: every stage's multipliers, in reverse (see
+        /// `Structured::straight_step`).
+        #[allow(clippy::too_many_arguments)]
+        fn straight_forces(
+            &self,
+            #(#parameters,)*
+            #trig_cache: &[f64],
+            lambda: &mut [f64; #dim],
+            #archive: &[f64; #archived],
+            #context: &::mechgen_runtime::codegen::StepContext,
+        ) -> ::core::result::Result<(), usize> {
+            #view
+            #(#code)*
+            ::core::result::Result::Ok(())
+        }
+    };
+    Some(ForceSolve { function, call })
+}
+
+/// The straight step's force solve: its function and the step's call of it.
+pub(super) struct ForceSolve {
+    pub(super) function: TokenStream,
+    pub(super) call: TokenStream,
+}
