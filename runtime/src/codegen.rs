@@ -21,5 +21,5 @@ pub use crate::step::{BlockScales, StepContext, StepReport};
 pub use crate::structure::{Block, Pattern, Stage};
 #[cfg(feature = "alloc")]
 pub use crate::workspace::VecBuffers;
-pub use crate::workspace::{Buffers, Parts, Workspace};
+pub use crate::workspace::{Buffers, Parts, StepParts, Workspace};
 pub use step::Choice;

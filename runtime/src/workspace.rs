@@ -19,11 +19,24 @@ pub trait Workspace {
     /// buffer.
     fn diagnosis(&self) -> (&[usize], &[usize]);
 
-    /// The trig cache alone (the `trig` of [`Parts`]), for the straight step, which needs
-    /// nothing else.
-    fn trig(&mut self) -> &mut [f64] {
-        self.parts().trig
+    /// What the straight step borrows (the trig cache and the force storage of [`Parts`]),
+    /// without building the rest.
+    fn step_parts(&mut self) -> StepParts<'_> {
+        let parts = self.parts();
+        StepParts {
+            trig: parts.trig,
+            forces: parts.forces,
+            archived: parts.archived,
+        }
     }
+}
+
+/// The buffers the straight step borrows: the trig cache, and, for a scene that computes
+/// forces, the force solve's storage and which blocks' factors it holds.
+pub struct StepParts<'a> {
+    pub(crate) trig: &'a mut [f64],
+    pub(crate) forces: &'a mut [f64],
+    pub(crate) archived: &'a mut [bool],
 }
 
 /// The buffers of a [`Workspace`], each at least as long as the scene's largest block needs
@@ -233,8 +246,12 @@ impl<const B: usize, const S: usize, const K: usize, const N: usize, const T: us
         (&self.indices[1], &self.undetermined)
     }
 
-    fn trig(&mut self) -> &mut [f64] {
-        &mut self.trig
+    fn step_parts(&mut self) -> StepParts<'_> {
+        StepParts {
+            trig: &mut self.trig,
+            forces: &mut self.forces,
+            archived: &mut self.archived,
+        }
     }
 }
 
@@ -307,8 +324,12 @@ impl Workspace for VecBuffers {
         (&self.indices[1], &self.undetermined)
     }
 
-    fn trig(&mut self) -> &mut [f64] {
-        &mut self.trig
+    fn step_parts(&mut self) -> StepParts<'_> {
+        StepParts {
+            trig: &mut self.trig,
+            forces: &mut self.forces,
+            archived: &mut self.archived,
+        }
     }
 }
 

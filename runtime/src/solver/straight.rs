@@ -57,7 +57,7 @@ where
         let done = if rates == Rates::Forces {
             self.straight_forces(t, state, &context, &mut report)
         } else {
-            let trig = self.workspace.trig();
+            let trig = self.workspace.step_parts().trig;
             let (q, qd, qdd) = (
                 &mut state.q,
                 &mut state.velocities,
@@ -66,7 +66,7 @@ where
             let m = &self.mechanism;
             m.straight_step(t, q, qd, qdd, trig, &mut [], &context, &mut report)
                 .is_ok()
-                && markers(m, t, state, self.workspace.trig())
+                && markers(m, t, state, trig)
         };
         if !done {
             return Ok(None);
@@ -99,7 +99,7 @@ where
         report: &mut StepReport,
     ) -> bool {
         let m = &self.mechanism;
-        let parts = self.workspace.parts();
+        let parts = self.workspace.step_parts();
         let (q, qd, qdd) = (
             &mut state.q,
             &mut state.velocities,
