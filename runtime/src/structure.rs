@@ -204,6 +204,25 @@ where
         Err(0)
     }
 
+    /// The velocities at the positions `q` of the last full solve of a scene that computes
+    /// forces, with every block's static factors archived in `forces` (the workspace's force
+    /// storage) by that solve: every stage in order, explicit ones assigned, each block's
+    /// right-hand side solved with its archived factors (the integrator's columns of
+    /// `∂q̇/∂u̇`). Generated with the straight step. `Err(stage)` for a non-finite block rate
+    /// (or, by default, for a scene without a straight step): the solver then solves them
+    /// the generic way.
+    fn straight_velocities(
+        &self,
+        _t: f64,
+        _q: &Vector<Self::Dim>,
+        _trig: &[f64],
+        _qd: &mut Vector<Self::Dim>,
+        _forces: &[f64],
+        _context: &StepContext,
+    ) -> Result<(), usize> {
+        Err(0)
+    }
+
     /// Writes the sines and cosines of the angles stage `stage` solved into the trig cache, once
     /// its positions in `q` are final.
     fn fill_trig(&self, _stage: usize, _q: &Vector<Self::Dim>, _trig: &mut [f64]) {}

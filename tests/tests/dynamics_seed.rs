@@ -23,7 +23,8 @@ use mechgen_examples::inverse_dynamics::seed_reactions;
 use mechgen_examples::scenes::PistonCrankFree;
 use mechgen_runtime::nalgebra::DefaultAllocator;
 use mechgen_runtime::{
-    Dynamic, EquationsOfMotion, FreeStorage, IntegratorOptions, Storage, Structured,
+    Dynamic, EquationsOfMotion, FreeStorage, Integrator, IntegratorOptions, Solver, SolverOptions,
+    Storage, Structured,
 };
 use mechgen_tests::example_scene;
 use mechgen_tests::reference::generalized_alpha::GeneralizedAlpha;
@@ -310,6 +311,47 @@ fn generated_and_interpreted_step_alike() {
         assert!((ea.total() - eb.total()).abs() <= 1e-9 * ea.kinetic.abs().max(1e5));
     }
     assert_eq!(generated.stats().steps, twin.stats().steps);
+}
+
+/// The straight step (its closed forms, its force solve, `V` by `straight_velocities` over
+/// its archived factors) steps as the stage sweep with `V` over the sweep's archive, and as
+/// partial pivoting with `V` refactored: the same steps, iterations and motion to round-off
+/// (a wrong `V` changes the Newton iterations, not the answer).
+#[test]
+fn the_straight_step_steps_as_the_sweep_and_refactored_velocities() {
+    let run = |options: SolverOptions| {
+        let solver = Solver::with_options(FreeSeed::default(), options);
+        let mut integrator =
+            Integrator::new(solver, 0.0, fixed(1e-3, 0.8)).unwrap_or_else(|e| panic!("{e}"));
+        let motion: Vec<[f64; 3]> = times(0.5, 50)
+            .iter()
+            .map(|&t| {
+                integrator.step_to(t).unwrap_or_else(|e| panic!("{e}"));
+                integrator.free_state(0)
+            })
+            .collect();
+        (motion, integrator.stats())
+    };
+    let (straight, stats) = run(SolverOptions::default());
+    for reference in [
+        SolverOptions {
+            straight_step: false,
+            ..SolverOptions::default()
+        },
+        SolverOptions {
+            static_pivots: false,
+            ..SolverOptions::default()
+        },
+    ] {
+        let (motion, reference_stats) = run(reference);
+        assert_eq!(
+            (stats.steps, stats.iterations),
+            (reference_stats.steps, reference_stats.iterations)
+        );
+        for (a, b) in straight.iter().zip(&motion) {
+            assert!(worst(a, b) <= 1e-10, "{a:?} vs {b:?}");
+        }
+    }
 }
 
 #[test]

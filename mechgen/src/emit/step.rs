@@ -14,14 +14,15 @@ use quote::{format_ident, quote};
 use super::body::Context;
 use super::idx;
 use super::plan::{Kernel, named_kernel_function};
-use super::step_forces::{ForceSolve, archive_ranges, straight_forces};
+use super::step_forces::{ForceSolve, archive_ranges, straight_forces, straight_velocities};
 use crate::expr::Id;
 use crate::model::{Outputs, Unit};
 use crate::plan::kernels::{Buffer, Kernels, Method, StageKernel, StageShape};
 use crate::plan::trig::Phase;
 
 /// The straight step of a scene that can have one: the inherent function that runs the
-/// stages, and the `Structured` method that calls it and restores the guess when it fails.
+/// stages, and the `Structured` method that calls it and restores the guess when it fails
+/// (with, for a scene that computes forces, `straight_velocities`).
 /// `functions` are the kernels' functions, in `kernels.stages` order.
 pub(super) fn straight_step(
     cx: &Context<'_>,
@@ -34,10 +35,12 @@ pub(super) fn straight_step(
     }
     let functions: Vec<&Kernel> = functions.iter().map(|(_, f)| f).collect();
     let mut stages = Stages::of(cx, kernels, &functions)?;
+    let mut methods = trait_method();
     if cx.model.outputs == Outputs::Forces {
         stages.forces = Some(straight_forces(cx, kernels, &functions)?);
+        methods.extend(straight_velocities(cx, kernels, &functions)?);
     }
-    Some((stages.function(cx, kernels, &functions), trait_method()))
+    Some((stages.function(cx, kernels, &functions), methods))
 }
 
 /// The step's stages as code, the Jacobian variants its blocks call, and, for a scene that

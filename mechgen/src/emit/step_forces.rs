@@ -1,9 +1,13 @@
-//! The straight step's force solve as code, for a scene that computes forces: the stages in
-//! reverse, as the runtime's force solve (`forces.rs`) runs them, with their kernels called
-//! directly (no dispatch on the stage index). An explicit stage assigns its multipliers in
-//! closed form; a block solves `Φ_q[b, b]ᵀ λ_b = F_b − Φ_q[later, b]ᵀ λ_later` with the
-//! static factors the forward step archived (`StepContext::multipliers`). The runtime then
-//! turns the multipliers into reactions and checks them once.
+//! What the straight step of a scene that computes forces adds, as code, over the block
+//! factors it archives, with the kernels called directly (no dispatch on the stage index):
+//! - its force solve, `straight_forces`: the stages in reverse, as the runtime's force solve
+//!   (`forces.rs`) runs them. An explicit stage assigns its multipliers in closed form; a
+//!   block solves `Φ_q[b, b]ᵀ λ_b = F_b − Φ_q[later, b]ᵀ λ_later` with its archived factors
+//!   (`StepContext::multipliers`). The runtime then turns the multipliers into reactions and
+//!   checks them once;
+//! - `Structured::straight_velocities`: the velocities again at the solved positions, each
+//!   block's with its archived factors (the integrator's columns of `∂q̇/∂u̇`, one velocity
+//!   solve per free degree of freedom).
 
 use core::ops::Range;
 
@@ -70,15 +74,8 @@ pub(super) fn straight_forces(
         });
     }
     let blocks = ranges.iter().any(Option::is_some);
-    let force_kernels: Vec<&Kernel> = kernels
-        .stages
-        .iter()
-        .zip(functions)
-        .filter(|(k, _)| matches!(k.method, Method::Multipliers | Method::ForceRhs))
-        .map(|(_, &f)| f)
-        .collect();
+    let force_kernels = of_methods(kernels, functions, &[Method::Multipliers, Method::ForceRhs]);
     let reads = |name: &str| force_kernels.iter().any(|f| f.arguments.contains(&name));
-    let named = |used: bool, name: &str| format_ident!("{}{}", if used { "" } else { "_" }, name);
     // The motion's arguments the kernels read, in the caller's order.
     let vector = cx.vector_type();
     let motion: Vec<(Ident, TokenStream)> = [("t", quote!(f64)), ("q", quote!(&#vector))]
@@ -101,7 +98,7 @@ pub(super) fn straight_forces(
             },
         ),
     };
-    let (archive, context) = (named(blocks, "archive"), named(blocks, "context"));
+    let (archive, context) = (unused(blocks, "archive"), unused(blocks, "context"));
     let (dim, archived): (Literal, Literal) = (
         idx(cx.model.dim()),
         idx(ranges.iter().flatten().map(|r| r.len()).sum()),
@@ -135,4 +132,109 @@ pub(super) fn straight_forces(
 pub(super) struct ForceSolve {
     pub(super) function: TokenStream,
     pub(super) call: TokenStream,
+}
+
+/// `Structured::straight_velocities`: the stages in order, each explicit one's velocities
+/// kernel, each block's velocity right-hand side solved with its archived factors. `None`
+/// when a block has no static LU. It names `_t`, `_q`, … the arguments no kernel reads.
+pub(super) fn straight_velocities(
+    cx: &Context<'_>,
+    kernels: &Kernels,
+    functions: &[&Kernel],
+) -> Option<TokenStream> {
+    let ranges = archive_ranges(kernels);
+    let mut code = Vec::new();
+    for (s, shape) in kernels.shapes.iter().enumerate() {
+        let calls = StageCalls::of(kernels, functions, s);
+        let Some(block) = &shape.block else {
+            code.push(calls.call(Method::Velocities));
+            continue;
+        };
+        let (stage, slots) = (idx(s), idx(block.slots));
+        let start = idx(ranges[s].as_ref()?.start);
+        let n = idx(shape.coordinates.len());
+        let solve = format_ident!("solve_{}", block.factorization?);
+        let scales = block_scales(cx, shape);
+        let velocity_rhs = calls.call(Method::VelocityRhs);
+        let coordinates = shape.coordinates.iter().map(|&c| idx(c));
+        let locals = (0..shape.coordinates.len()).map(idx);
+        code.push(quote! {
+            {
+                let ::core::option::Option::Some(values) = archive[#start..].first_chunk::<#slots>()
+                else {
+                    return ::core::result::Result::Err(#stage);
+                };
+                let scales = #scales;
+                let out = &mut [0.0_f64; #n];
+                #velocity_rhs
+                let x = context.rates(#stage, out, &scales, |x| Self::#solve(values, x))?;
+                #(qd[#coordinates] = x[#locals];)*
+            }
+        });
+    }
+    let velocity_kernels = of_methods(
+        kernels,
+        functions,
+        &[Method::Velocities, Method::VelocityRhs],
+    );
+    let reads = |name: &str| velocity_kernels.iter().any(|f| f.arguments.contains(&name));
+    let blocks = ranges.iter().any(Option::is_some);
+    let [t, q, trig] = ["t", "q", "trig"].map(|name| unused(reads(name), name));
+    let (forces, context) = (unused(blocks, "forces"), unused(blocks, "context"));
+    let (dim, archived, trig_len) = (
+        idx(cx.model.dim()),
+        idx(ranges.iter().flatten().map(|r| r.len()).sum()),
+        idx(kernels.sizes.trig),
+    );
+    let view = reads("trig").then(|| {
+        quote! {
+            let ::core::option::Option::Some(trig) = trig.first_chunk::<#trig_len>() else {
+                return ::core::result::Result::Err(0);
+            };
+        }
+    });
+    let archive = blocks.then(|| {
+        quote! {
+            let ::core::option::Option::Some(archive) =
+                forces.get(#dim..).and_then(|a| a.first_chunk::<#archived>())
+            else {
+                return ::core::result::Result::Err(0);
+            };
+        }
+    });
+    let vector = quote!(::mechgen_runtime::Vector<Self::Dim>);
+    Some(quote! {
+        fn straight_velocities(
+            &self,
+            #t: f64,
+            #q: &#vector,
+            #trig: &[f64],
+            qd: &mut #vector,
+            #forces: &[f64],
+            #context: &::mechgen_runtime::codegen::StepContext,
+        ) -> ::core::result::Result<(), usize> {
+            #view
+            #archive
+            #(#code)*
+            ::core::result::Result::Ok(())
+        }
+    })
+}
+
+/// The functions of the kernels of `methods`.
+fn of_methods<'k>(
+    kernels: &Kernels,
+    functions: &[&'k Kernel],
+    methods: &[Method],
+) -> Vec<&'k Kernel> {
+    let kernels = kernels.stages.iter().zip(functions);
+    kernels
+        .filter(|(k, _)| methods.contains(&k.method))
+        .map(|(_, &f)| f)
+        .collect()
+}
+
+/// `name`, or `_name` where it is not used.
+fn unused(used: bool, name: &str) -> Ident {
+    format_ident!("{}{}", if used { "" } else { "_" }, name)
 }

@@ -8,9 +8,11 @@
 //! a pass of the scene's whole Jacobian code through the caches. Solving with the very factors
 //! the state's own `q̇` was solved with also makes `q̇(u̇ + δ) − q̇(u̇)` exactly linear in `δ`.
 //!
-//! Where it cannot (no archive at these positions, a block the archive lacks after a
-//! partial-pivoting fallback, a non-finite value on the way), it declines and the caller runs
-//! the refactoring solve, which also names any error.
+//! A scene with a straight step solves them by its generated `straight_velocities` (the
+//! stages' kernels called directly), others stage by stage here. Where it cannot (no archive
+//! at these positions, a block the archive lacks after a partial-pivoting fallback, a
+//! non-finite value on the way), it declines and the caller runs the refactoring solve, which
+//! also names any error.
 
 use nalgebra::DefaultAllocator;
 
@@ -42,10 +44,24 @@ where
         t: f64,
         qd: &mut Vector<M::Dim>,
     ) -> Result<(), crate::SolveError> {
-        if self.factors_archived && self.archived_velocities(q, t, qd).is_ok() {
+        if self.factors_archived
+            && (self.straight_velocities(q, t, qd) || self.archived_velocities(q, t, qd).is_ok())
+        {
             return Ok(());
         }
         self.solve_velocity(q, t, qd)
+    }
+
+    /// The scene's generated [`Structured::straight_velocities`] where every block's factors
+    /// are archived; whether it solved them all, finite.
+    fn straight_velocities(&mut self, q: &Vector<M::Dim>, t: f64, qd: &mut Vector<M::Dim>) -> bool {
+        let parts = self.workspace.step_parts();
+        parts.archived.iter().all(|&kept| kept)
+            && self
+                .mechanism
+                .straight_velocities(t, q, parts.trig, qd, parts.forces, &self.context)
+                .is_ok()
+            && all_finite(qd.as_slice())
     }
 
     /// The stages in order: explicit ones assigned, each block's right-hand side solved with
