@@ -185,7 +185,7 @@ where
     /// without forces.
     pub(crate) fn multipliers(&mut self) -> &[f64] {
         let n = nalgebra::Dim::value(&self.mechanism.dim());
-        let forces = self.workspace.parts().forces;
+        let forces = self.workspace.step_parts().forces;
         forces.get(..n).unwrap_or(&[])
     }
 
