@@ -92,44 +92,9 @@ impl Stages {
     /// no kernel reads are named `_t`, `_report`, `_forces`.
     fn function(&self, cx: &Context<'_>, kernels: &Kernels, functions: &[&Kernel]) -> TokenStream {
         let reads = |name: &str| functions.iter().any(|f| f.arguments.contains(&name));
-        let unused = |used: bool, name: &str| {
-            let name = if used {
-                name.to_string()
-            } else {
-                format!("_{name}")
-            };
-            format_ident!("{}", name)
-        };
         let (t, report) = (unused(reads("t"), "t"), unused(self.blocks, "report"));
         let forces = unused(self.forces.is_some(), "forces");
-        let (dim, archived) = (
-            idx(cx.model.dim()),
-            idx(kernels
-                .sizes
-                .forces
-                .unwrap_or(0)
-                .saturating_sub(cx.model.dim())),
-        );
-        // The force storage as the multipliers' and the archive's arrays, and the force solve
-        // after the end checks.
-        let (split, force_solve) = match &self.forces {
-            None => Default::default(),
-            Some(forces) => (
-                quote! {
-                    let ::core::option::Option::Some((lambda, archive)) =
-                        forces.split_first_chunk_mut::<#dim>()
-                    else {
-                        return ::core::result::Result::Err(0);
-                    };
-                    let ::core::option::Option::Some(archive) =
-                        archive.first_chunk_mut::<#archived>()
-                    else {
-                        return ::core::result::Result::Err(0);
-                    };
-                },
-                forces.call.clone(),
-            ),
-        };
+        let (storage, force_solve) = self.forces.as_ref().map(|f| (&f.storage, &f.call)).unzip();
         let force_function = self.forces.as_ref().map(|f| &f.function);
         let trig_len = idx(kernels.sizes.trig);
         let view = reads("trig").then(|| {
@@ -164,7 +129,7 @@ impl Stages {
                 #report: &mut ::mechgen_runtime::codegen::StepReport,
             ) -> ::core::result::Result<(), usize> {
                 #view
-                #split
+                #storage
                 #(#stages)*
                 let end = Self::STAGES.len();
                 context.check_rounding(end, &[#(#lengths),*], &[#(#angles),*])?;
@@ -256,6 +221,11 @@ fn trait_method() -> TokenStream {
             result
         }
     }
+}
+
+/// `name`, or `_name` where it is not used (a parameter of generated code).
+pub(super) fn unused(used: bool, name: &str) -> Ident {
+    format_ident!("{}{}", if used { "" } else { "_" }, name)
 }
 
 /// `context.scales(…)`: a block's row and column scales, from its equations' and

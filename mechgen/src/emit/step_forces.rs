@@ -17,7 +17,7 @@ use quote::{format_ident, quote};
 use super::body::Context;
 use super::idx;
 use super::plan::Kernel;
-use super::step::{StageCalls, block_scales};
+use super::step::{StageCalls, block_scales, unused};
 use crate::plan::kernels::{Kernels, Method};
 
 /// Where each stage's factors go in the force solve's archive (after the multipliers): a
@@ -44,35 +44,7 @@ pub(super) fn straight_forces(
     functions: &[&Kernel],
 ) -> Option<ForceSolve> {
     let ranges = archive_ranges(kernels);
-    let mut code = Vec::new();
-    for (s, shape) in kernels.shapes.iter().enumerate().rev() {
-        let calls = StageCalls::of(kernels, functions, s);
-        let Some(block) = &shape.block else {
-            code.push(calls.call(Method::Multipliers));
-            continue;
-        };
-        let (stage, slots) = (idx(s), idx(block.slots));
-        let start = idx(ranges[s].as_ref()?.start);
-        let n = idx(shape.coordinates.len());
-        let solve_transpose = format_ident!("solve_transpose_{}", block.factorization?);
-        let scales = block_scales(cx, shape);
-        let force_rhs = calls.call(Method::ForceRhs);
-        let equations = shape.equations.iter().map(|&e| idx(e));
-        let locals = (0..shape.equations.len()).map(idx);
-        code.push(quote! {
-            {
-                let ::core::option::Option::Some(values) = archive[#start..].first_chunk::<#slots>()
-                else {
-                    return ::core::result::Result::Err(#stage);
-                };
-                let scales = #scales;
-                let out = &mut [0.0_f64; #n];
-                #force_rhs
-                let x = context.multipliers(out, &scales, |x| Self::#solve_transpose(values, x));
-                #(lambda[#equations] = x[#locals];)*
-            }
-        });
-    }
+    let code = Pass::Forces.stages(cx, kernels, functions, &ranges)?;
     let blocks = ranges.iter().any(Option::is_some);
     let force_kernels = of_methods(kernels, functions, &[Method::Multipliers, Method::ForceRhs]);
     let reads = |name: &str| force_kernels.iter().any(|f| f.arguments.contains(&name));
@@ -85,19 +57,7 @@ pub(super) fn straight_forces(
         .map(|(name, ty)| (format_ident!("{}", name), ty))
         .collect();
     // The trig cache is viewed as its array again: the step's end checks read it whole.
-    let trig_len = idx(kernels.sizes.trig);
-    let (trig_cache, view) = match reads("trig") {
-        false => (format_ident!("_trig_cache"), TokenStream::new()),
-        true => (
-            format_ident!("trig_cache"),
-            quote! {
-                let ::core::option::Option::Some(trig) = trig_cache.first_chunk::<#trig_len>()
-                else {
-                    return ::core::result::Result::Err(0);
-                };
-            },
-        ),
-    };
+    let (trig_cache, view) = trig_view(kernels, reads("trig"));
     let (archive, context) = (unused(blocks, "archive"), unused(blocks, "context"));
     let (dim, archived): (Literal, Literal) = (
         idx(cx.model.dim()),
@@ -125,13 +85,30 @@ pub(super) fn straight_forces(
             ::core::result::Result::Ok(())
         }
     };
-    Some(ForceSolve { function, call })
+    let storage = quote! {
+        let ::core::option::Option::Some((lambda, archive)) =
+            forces.split_first_chunk_mut::<#dim>()
+        else {
+            return ::core::result::Result::Err(0);
+        };
+        let ::core::option::Option::Some(archive) = archive.first_chunk_mut::<#archived>() else {
+            return ::core::result::Result::Err(0);
+        };
+    };
+    Some(ForceSolve {
+        storage,
+        call,
+        function,
+    })
 }
 
-/// The straight step's force solve: its function and the step's call of it.
+/// The straight step's force solve: the step's view of the force storage as the multipliers'
+/// and the archive's arrays, its call of the force solve after the end checks, and the
+/// function.
 pub(super) struct ForceSolve {
-    pub(super) function: TokenStream,
+    pub(super) storage: TokenStream,
     pub(super) call: TokenStream,
+    pub(super) function: TokenStream,
 }
 
 /// `Structured::straight_velocities`: the stages in order, each explicit one's velocities
@@ -143,35 +120,7 @@ pub(super) fn straight_velocities(
     functions: &[&Kernel],
 ) -> Option<TokenStream> {
     let ranges = archive_ranges(kernels);
-    let mut code = Vec::new();
-    for (s, shape) in kernels.shapes.iter().enumerate() {
-        let calls = StageCalls::of(kernels, functions, s);
-        let Some(block) = &shape.block else {
-            code.push(calls.call(Method::Velocities));
-            continue;
-        };
-        let (stage, slots) = (idx(s), idx(block.slots));
-        let start = idx(ranges[s].as_ref()?.start);
-        let n = idx(shape.coordinates.len());
-        let solve = format_ident!("solve_{}", block.factorization?);
-        let scales = block_scales(cx, shape);
-        let velocity_rhs = calls.call(Method::VelocityRhs);
-        let coordinates = shape.coordinates.iter().map(|&c| idx(c));
-        let locals = (0..shape.coordinates.len()).map(idx);
-        code.push(quote! {
-            {
-                let ::core::option::Option::Some(values) = archive[#start..].first_chunk::<#slots>()
-                else {
-                    return ::core::result::Result::Err(#stage);
-                };
-                let scales = #scales;
-                let out = &mut [0.0_f64; #n];
-                #velocity_rhs
-                let x = context.rates(#stage, out, &scales, |x| Self::#solve(values, x))?;
-                #(qd[#coordinates] = x[#locals];)*
-            }
-        });
-    }
+    let code = Pass::Velocities.stages(cx, kernels, functions, &ranges)?;
     let velocity_kernels = of_methods(
         kernels,
         functions,
@@ -179,20 +128,13 @@ pub(super) fn straight_velocities(
     );
     let reads = |name: &str| velocity_kernels.iter().any(|f| f.arguments.contains(&name));
     let blocks = ranges.iter().any(Option::is_some);
-    let [t, q, trig] = ["t", "q", "trig"].map(|name| unused(reads(name), name));
+    let [t, q] = ["t", "q"].map(|name| unused(reads(name), name));
     let (forces, context) = (unused(blocks, "forces"), unused(blocks, "context"));
-    let (dim, archived, trig_len) = (
+    let (dim, archived) = (
         idx(cx.model.dim()),
         idx(ranges.iter().flatten().map(|r| r.len()).sum()),
-        idx(kernels.sizes.trig),
     );
-    let view = reads("trig").then(|| {
-        quote! {
-            let ::core::option::Option::Some(trig) = trig.first_chunk::<#trig_len>() else {
-                return ::core::result::Result::Err(0);
-            };
-        }
-    });
+    let (trig_cache, view) = trig_view(kernels, reads("trig"));
     let archive = blocks.then(|| {
         quote! {
             let ::core::option::Option::Some(archive) =
@@ -208,7 +150,7 @@ pub(super) fn straight_velocities(
             &self,
             #t: f64,
             #q: &#vector,
-            #trig: &[f64],
+            #trig_cache: &[f64],
             qd: &mut #vector,
             #forces: &[f64],
             #context: &::mechgen_runtime::codegen::StepContext,
@@ -219,6 +161,97 @@ pub(super) fn straight_velocities(
             ::core::result::Result::Ok(())
         }
     })
+}
+
+/// A pass over the stages with the blocks' archived factors.
+#[derive(Clone, Copy)]
+enum Pass {
+    /// The force solve: the stages in reverse, multipliers.
+    Forces,
+    /// The velocities: the stages in order.
+    Velocities,
+}
+
+impl Pass {
+    /// Each stage's code, in the pass's order: an explicit stage's kernel, a block's
+    /// right-hand side solved with its archived factors (`archive`, at `ranges`) and written
+    /// to its equations' multipliers or its coordinates' velocities. `None` for a block
+    /// without a static LU.
+    fn stages(
+        self,
+        cx: &Context<'_>,
+        kernels: &Kernels,
+        functions: &[&Kernel],
+        ranges: &[Option<Range<usize>>],
+    ) -> Option<Vec<TokenStream>> {
+        let (explicit, rhs) = match self {
+            Pass::Forces => (Method::Multipliers, Method::ForceRhs),
+            Pass::Velocities => (Method::Velocities, Method::VelocityRhs),
+        };
+        let mut code = Vec::new();
+        for (s, shape) in kernels.shapes.iter().enumerate() {
+            let calls = StageCalls::of(kernels, functions, s);
+            let Some(block) = &shape.block else {
+                code.push(calls.call(explicit));
+                continue;
+            };
+            let (stage, slots) = (idx(s), idx(block.slots));
+            let start = idx(ranges[s].as_ref()?.start);
+            let n = idx(shape.coordinates.len());
+            let scales = block_scales(cx, shape);
+            let rhs = calls.call(rhs);
+            let factorization = block.factorization?;
+            let (solve, targets) = match self {
+                Pass::Forces => {
+                    let solve = format_ident!("solve_transpose_{}", factorization);
+                    let solve =
+                        quote!(context.multipliers(out, &scales, |x| Self::#solve(values, x)));
+                    (solve, (quote!(lambda), &shape.equations))
+                }
+                Pass::Velocities => {
+                    let solve = format_ident!("solve_{}", factorization);
+                    let solve =
+                        quote!(context.rates(#stage, out, &scales, |x| Self::#solve(values, x))?);
+                    (solve, (quote!(qd), &shape.coordinates))
+                }
+            };
+            let (target, indices) = targets;
+            let (indices, locals) = (indices.iter().map(|&i| idx(i)), (0..indices.len()).map(idx));
+            code.push(quote! {
+                {
+                    let ::core::option::Option::Some(values) =
+                        archive[#start..].first_chunk::<#slots>()
+                    else {
+                        return ::core::result::Result::Err(#stage);
+                    };
+                    let scales = #scales;
+                    let out = &mut [0.0_f64; #n];
+                    #rhs
+                    let x = #solve;
+                    #(#target[#indices] = x[#locals];)*
+                }
+            });
+        }
+        if let Pass::Forces = self {
+            code.reverse();
+        }
+        Some(code)
+    }
+}
+
+/// The trig cache parameter of a pass's function (`_trig_cache` where no kernel reads it,
+/// `used`) and its view as the array the kernels take.
+fn trig_view(kernels: &Kernels, used: bool) -> (Ident, TokenStream) {
+    if !used {
+        return (format_ident!("_trig_cache"), TokenStream::new());
+    }
+    let trig_len = idx(kernels.sizes.trig);
+    let view = quote! {
+        let ::core::option::Option::Some(trig) = trig_cache.first_chunk::<#trig_len>() else {
+            return ::core::result::Result::Err(0);
+        };
+    };
+    (format_ident!("trig_cache"), view)
 }
 
 /// The functions of the kernels of `methods`.
@@ -232,9 +265,4 @@ fn of_methods<'k>(
         .filter(|(k, _)| methods.contains(&k.method))
         .map(|(_, &f)| f)
         .collect()
-}
-
-/// `name`, or `_name` where it is not used.
-fn unused(used: bool, name: &str) -> Ident {
-    format_ident!("{}{}", if used { "" } else { "_" }, name)
 }
