@@ -37,6 +37,7 @@ use self::energy::Book;
 use self::newton::{Failure, IterationMatrix};
 use self::reduced::{Reduced, set_free};
 use self::states::States;
+use self::toggle::Watch;
 use crate::assembly::GUESS_TIME;
 use crate::dynamic::{Dynamic, EquationsOfMotion, FreeStorage};
 #[cfg(doc)]
@@ -91,8 +92,8 @@ where
     options: IntegratorOptions,
     /// The next step's size.
     step: f64,
-    /// `‖V‖` at the last (re)start, against which a toggle's approach is measured.
-    sensitivity: f64,
+    /// The toggle checks' bound on `‖V‖` and per-coordinate floors.
+    watch: Watch<M>,
     book: Book<M>,
     stats: IntegratorStats,
 }
@@ -118,7 +119,7 @@ where
             alpha: self.alpha,
             options: self.options,
             step: self.step,
-            sensitivity: self.sensitivity,
+            watch: self.watch.clone(),
             book: self.book.clone(),
             stats: self.stats,
         }
@@ -197,7 +198,7 @@ where
             alpha: Alpha::new(options.rho_inf),
             options,
             step,
-            sensitivity: f64::INFINITY,
+            watch: Watch::new(m),
             book: Book::new(m),
             stats: IntegratorStats::default(),
             solver,
@@ -225,7 +226,7 @@ where
         self.matrix.step = None;
         solved.map_err(|failure| self.failure(failure, t, 0.0))?;
         self.next.a.copy_from(&self.next.udd);
-        self.sensitivity = self.reduced.v.norm();
+        self.watch.restart(self.reduced.v.norm());
         self.reduced.accepted.copy_from(&self.reduced.v);
         self.earlier_step = 0.0;
         self.states.accept();
