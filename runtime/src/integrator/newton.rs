@@ -311,7 +311,7 @@ where
         self.correction.copy_from(&self.next.u);
         self.correction -= &self.now.u;
         trial.q.gemv(1.0, &self.reduced.v, &self.correction, 1.0);
-        if trial.q.iter().any(|x| !x.is_finite()) {
+        if trial.q.as_slice().iter().any(|x| !x.is_finite()) {
             // A V left by a failed restart elsewhere: start from the positions as they are.
             trial.q.copy_from(&state.q);
         }

@@ -26,21 +26,27 @@
 //!   so the test is made only on steps that resolve the free motion (their free
 //!   accelerations change little over the step, below [`RESOLVED`] of the scale); a step
 //!   that does not (an unresolved stiff mode at ρ∞ < 1 excited) is left to the other two
-//!   checks.
+//!   checks. Only coordinates a branch decides are watched: those of the plan's blocks and
+//!   of explicit stages downstream of one (the others are affine assignments from time and
+//!   the free states, the same on either branch).
+//!
+//! The checks run cheapest first (the signs, `‖V‖²` against a bound set at the start, the
+//! free accelerations' jump), and the kink's pass over the watched coordinates last, with
+//! their floors found once ([`Watch`]).
 //!
 //! Fixed steps fail on a flagged step. The error-controlled mode retries it smaller, as any
 //! failed step: the kink of a step that straddles the toggle persists as the step shrinks,
 //! but the shorter retry no longer straddles it, so the steps close in on the toggle until the
 //! growth of `‖V‖` (or the minimum step) stops them with the typed error, just before it.
 
-use nalgebra::{DefaultAllocator, U1};
+use nalgebra::{DefaultAllocator, OVector, U1};
 
 use super::Integrator;
 use super::control::usable_length;
 use super::newton::{ACCELERATION_FLOOR, Failure};
 use crate::dynamic::{Dynamic, EquationsOfMotion, FreeStorage};
 use crate::mechanism::{LengthScale, Mechanism, Storage, Vector};
-use crate::structure::Structured;
+use crate::structure::{Stage, Structured};
 
 /// How far `‖V‖` may grow past its value at the start before the state counts as at a
 /// toggle of the partition: the reduced mass then grew about a million times.
@@ -54,19 +60,21 @@ const KINK: f64 = 0.5;
 /// jumps, above 1 (1.3–1.6 on the stiff slider-crank at ρ∞ = 0).
 const RESOLVED: f64 = 0.25;
 
-/// What the checks keep between steps: the bound on `‖V‖²` set at the last (re)start, each
-/// coordinate's floor (computed once), and the explained parts of the defects (scratch).
+/// What the checks keep between steps: the bound on `‖V‖²` set at the last (re)start, and
+/// the coordinates the kink test watches with their floors (found once).
 pub(crate) struct Watch<M: Mechanism>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
     /// `(TOGGLE_GROWTH ‖V‖)²` at the last (re)start (infinite before the first).
     limit: f64,
-    /// Per coordinate, [`ACCELERATION_FLOOR`] of its unit in scene scales: over a step of
-    /// size `h`, rates below this over `h` count as zero.
+    /// The coordinates a reflection can kink, ascending, in the first `count` entries
+    /// ([`watched`]).
+    watched: OVector<usize, M::Dim>,
+    count: usize,
+    /// Per watched coordinate, [`ACCELERATION_FLOOR`] of its unit in scene scales: over a
+    /// step of size `h`, rates below this over `h` count as zero.
     floors: Vector<M::Dim>,
-    /// Per coordinate, the part of its defect the free motion explains.
-    explained: Vector<M::Dim>,
 }
 
 impl<M: Mechanism> Clone for Watch<M>
@@ -76,24 +84,32 @@ where
     fn clone(&self) -> Self {
         Self {
             limit: self.limit,
+            watched: self.watched.clone(),
+            count: self.count,
             floors: self.floors.clone(),
-            explained: self.explained.clone(),
         }
     }
 }
 
-impl<M: Mechanism> Watch<M>
+impl<M: Structured> Watch<M>
 where
     DefaultAllocator: Storage<M::Dim>,
 {
     /// The checks for `m`, before the first start.
     pub fn new(m: &M) -> Self {
+        let n = m.dim();
+        let mut watched = OVector::from_element_generic(n, U1, 0);
+        let count = watched_coordinates(m.stage_count(), |s| m.stage(s), watched.as_mut_slice());
         let length = LengthScale::new(usable_length(m.length_scale()));
-        let floor = |i, _| ACCELERATION_FLOOR * length.of(m.coordinate_unit(i));
+        let mut floors = Vector::zeros_generic(n, U1);
+        for (floor, &i) in floors.iter_mut().zip(watched.iter().take(count)) {
+            *floor = ACCELERATION_FLOOR * length.of(m.coordinate_unit(i));
+        }
         Self {
             limit: f64::INFINITY,
-            floors: Vector::from_fn_generic(m.dim(), U1, floor),
-            explained: Vector::zeros_generic(m.dim(), U1),
+            watched,
+            count,
+            floors,
         }
     }
 
@@ -102,6 +118,51 @@ where
         let limit = TOGGLE_GROWTH * norm;
         self.limit = limit * limit;
     }
+}
+
+/// Writes the coordinates a reflection can kink into the head of `out` (one entry per
+/// coordinate) and returns how many, from the plan's `count` stages (`stage`): all but those
+/// of explicit stages that read no block, directly or through other explicit stages. An
+/// explicit stage assigns each coordinate from an equation affine in it, so those coordinates
+/// are smooth functions of time and the free states, the same on either branch (the seed's
+/// grounds, its piston's y and angle, its crank's pose: 11 of 15); the others come from a
+/// block's solve, or from coordinates that do, and follow its branch.
+fn watched_coordinates<'a>(
+    count: usize,
+    stage: impl Fn(usize) -> Option<Stage<'a>>,
+    out: &mut [usize],
+) -> usize {
+    // First a flag per coordinate (1: watched), then the watched indices compacted in place.
+    out.fill(1);
+    for s in 0..count {
+        let Some(Stage::Explicit {
+            coordinates, reads, ..
+        }) = stage(s)
+        else {
+            continue;
+        };
+        let smooth = |r: usize| {
+            stage(r).is_some_and(|read| {
+                let mut flags = read.coordinates().iter().map(|&c| out.get(c).copied());
+                flags.all(|flag| flag == Some(0))
+            })
+        };
+        if reads.iter().all(|&r| smooth(r)) {
+            for &c in coordinates {
+                if let Some(flag) = out.get_mut(c) {
+                    *flag = 0;
+                }
+            }
+        }
+    }
+    let mut watched = 0;
+    for i in 0..out.len() {
+        if out[i] == 1 {
+            out[watched] = i;
+            watched += 1;
+        }
+    }
+    watched
 }
 
 impl<M: Dynamic + EquationsOfMotion + Structured> Integrator<M>
@@ -158,18 +219,18 @@ where
             .fold(0.0, f64::max)
     }
 
-    /// Whether, for some coordinate, the part of the trapezoid defect over the step of size
-    /// `h` that the free coordinates do not explain exceeds [`KINK`] times its scale (the
-    /// module documentation).
+    /// Whether, for some watched coordinate ([`watched_coordinates`]), the part of the
+    /// trapezoid defect over the step of size `h` that the free coordinates do not explain
+    /// exceeds [`KINK`] times its scale (the module documentation).
     ///
     /// With `q̇ = V u̇` (plus the drivers' terms, smooth in time), the defect is
     /// `d_q = V̄ d_u − (h/4) ΔV Δü + (ΔV ū̇ − (h/2)(V̇₀u̇₀ + V̇₁u̇₁))` (`V̄`, `ū̇` the ends'
     /// means, `Δ` their differences): the free coordinates' own defect `d_u` (large for an
     /// unresolved stiff mode, whose `u̇` and `ü` alternate) and the change of `V` against the
     /// jump of `ü` are the free motion's; the rest is `O(h³)` on a smooth `V` and the kink
-    /// at a reflection. The explained part, `V₀ (½ d_u + ¼ h Δü) + V₁ (½ d_u − ¼ h Δü)`
-    /// (two products with `V`), counts in the scale, so a coordinate at rest whose free
-    /// coordinates move gives no ratio out of round-off; and rates that would move a
+    /// at a reflection. The explained part, `V₀ (½ d_u + ¼ h Δü) + V₁ (½ d_u − ¼ h Δü)`,
+    /// counts in the scale, so a coordinate at rest whose free coordinates move gives no
+    /// ratio out of round-off; and rates that would move a
     /// coordinate by less than [`ACCELERATION_FLOOR`] of its unit (in scene scales) over the
     /// step count as zero in the scale, as in [`Self::free_jump`], so that one the motion
     /// leaves still (the falling scissor lift's platform x, released from rest) gives none
@@ -183,37 +244,21 @@ where
             at_start[k] = 0.5 * d_u + jump;
             at_end[k] = 0.5 * d_u - jump;
         }
-        let explained = &mut self.watch.explained;
-        explained.gemv(1.0, &self.reduced.accepted, at_start, 0.0);
-        explained.gemv(1.0, &self.reduced.v, at_end, 1.0);
         let (before, after) = (self.states.current(), self.states.trial());
-        let n = before.velocities.len();
-        let columns = [
-            &before.velocities,
-            &after.velocities,
-            &before.accelerations,
-            &after.accelerations,
-            explained,
-            &self.watch.floors,
-        ]
-        .map(|v| v.as_slice().get(..n));
-        let [
-            Some(v0),
-            Some(v1),
-            Some(a0),
-            Some(a1),
-            Some(part),
-            Some(floor),
-        ] = columns
-        else {
-            return false;
-        };
+        let (start, end) = (&self.reduced.accepted, &self.reduced.v);
+        let watch = &self.watch;
+        let watched = watch.watched.as_slice().iter().take(watch.count);
         let per_step = 1.0 / h;
-        // Every entry, without an early exit (a kink is rare).
+        // Every watched coordinate, without an early exit (a kink is rare).
         let mut kinked = false;
-        for i in 0..n {
-            let (v, a) = ([v0[i], v1[i]], [a0[i], a1[i]]);
-            kinked |= exceeds(v, a, h, part[i], floor[i] * per_step, KINK);
+        for (&i, &floor) in watched.zip(watch.floors.as_slice()) {
+            let mut part = 0.0;
+            for k in 0..at_start.len() {
+                part += start[(i, k)] * at_start[k] + end[(i, k)] * at_end[k];
+            }
+            let v = [before.velocities[i], after.velocities[i]];
+            let a = [before.accelerations[i], after.accelerations[i]];
+            kinked |= exceeds(v, a, h, part, floor * per_step, KINK);
         }
         kinked
     }
@@ -252,6 +297,7 @@ fn ratio(defect: f64, scale: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::structure::{Block, Pattern};
 
     /// A reflection's kink counts whatever the floor; the round-off of a coordinate the motion
     /// leaves at rest (the falling scissor lift's platform x over its first step from rest,
@@ -289,5 +335,61 @@ mod tests {
         ));
         // NaN rates are no kink (the finiteness checks report them).
         assert!(!exceeds([f64::NAN, 0.0], [0.0, 0.0], h, 0.0, floor, KINK));
+    }
+
+    fn block<'a>(coordinates: &'a [usize], reads: &'a [usize]) -> Stage<'a> {
+        Stage::Block(Block {
+            equations: coordinates,
+            coordinates,
+            pattern: Pattern::Dense,
+            slots: coordinates.len() * coordinates.len(),
+            pivots: &[],
+            reads,
+        })
+    }
+
+    fn explicit<'a>(coordinates: &'a [usize], reads: &'a [usize]) -> Stage<'a> {
+        Stage::Explicit {
+            equations: coordinates,
+            coordinates,
+            reads,
+        }
+    }
+
+    /// The watched coordinates of `n` (at most 16) under `stages`, and how many.
+    fn watched(stages: &[Stage<'_>], n: usize) -> ([usize; 16], usize) {
+        let mut out = [0; 16];
+        let count = watched_coordinates(stages.len(), |s| stages.get(s).copied(), &mut out[..n]);
+        (out, count)
+    }
+
+    /// The seed's plan (its snapshot): grounds, piston y and angle, crank x and y assigned from
+    /// nothing, the crank angle from its free state, the rod's block, and the rod's x and the
+    /// piston's x from the block: only the last four can follow a branch.
+    #[test]
+    fn the_kink_test_watches_what_a_block_decides() {
+        let seed = [
+            explicit(&[0, 1, 2, 4, 5, 9, 10, 12, 13, 14], &[]),
+            explicit(&[11], &[]),
+            block(&[7, 8], &[1]),
+            explicit(&[6, 3], &[1, 2]),
+        ];
+        let (seed, count) = watched(&seed, 15);
+        assert_eq!(seed[..count], [3, 6, 7, 8]);
+        // Explicit stages reading only explicit ones stay smooth, through a chain; one
+        // reading a block does not, nor one reading a stage downstream of a block.
+        let chain = [
+            explicit(&[0], &[]),
+            explicit(&[1], &[0]),
+            block(&[2], &[1]),
+            explicit(&[3], &[1]),
+            explicit(&[4], &[2]),
+            explicit(&[5], &[0, 4]),
+        ];
+        let (all, count) = watched(&chain, 6);
+        assert_eq!(all[..count], [2, 4, 5]);
+        // A coordinate no stage assigns (a plan cut short) is watched.
+        let (short, count) = watched(&chain[..2], 4);
+        assert_eq!(short[..count], [2, 3]);
     }
 }
