@@ -186,11 +186,13 @@ where
             return false;
         }
         m.nu(&state.q, state.t, &mut self.velocity);
+        // The free row's entry cleared (ν is scratch here), every entry must be zero.
+        let Some(free) = self.velocity.get_mut(row) else {
+            return false;
+        };
+        *free = 0.0;
         let nu = self.velocity.as_slice();
-        let others = nu.get(..row).zip(nu.get(row + 1..));
-        let scleronomic =
-            others.is_some_and(|(before, after)| before.iter().chain(after).all(|&nu| nu == 0.0));
-        if !scleronomic {
+        if !nu.iter().all(|&nu| nu == 0.0) {
             return false;
         }
         let Some(column) = self.v.as_mut_slice().get_mut(..nu.len()) else {
