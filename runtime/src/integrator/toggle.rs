@@ -69,7 +69,7 @@ where
     /// `(TOGGLE_GROWTH ‖V‖)²` at the last (re)start (infinite before the first).
     limit: f64,
     /// The coordinates a reflection can kink, ascending, in the first `count` entries
-    /// ([`watched`]).
+    /// ([`watched_coordinates`]).
     watched: OVector<usize, M::Dim>,
     count: usize,
     /// Per watched coordinate, [`ACCELERATION_FLOOR`] of its unit in scene scales: over a
