@@ -133,8 +133,7 @@ where
 
     /// Makes the step's iterate the current state and books its energy.
     fn accept(&mut self, h: f64) {
-        self.earlier.copy_from(&self.now.udd);
-        self.earlier_step = h;
+        self.history.accept(&self.next.udd, &self.correction, h);
         self.states.accept();
         core::mem::swap(&mut self.now, &mut self.next);
         self.reduced.accepted.copy_from(&self.reduced.v);

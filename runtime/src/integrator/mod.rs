@@ -13,13 +13,16 @@
 //! One concept per file: the [`Integrator`] and its API (here), the method's coefficients and
 //! update (`alpha.rs`), one evaluation of the reduced equations (`reduced.rs`), the step's
 //! modified Newton iteration (`newton.rs`), step control and landing on requested times
-//! (`control.rs`), the current state and the step's iterate (`states.rs`), the [`IntegratorOptions`] (`options.rs`), the [`Energy`] book (`energy.rs`)
+//! (`control.rs`), the current state and the step's iterate (`states.rs`), the predictor's
+//! history of accelerations (`history.rs`), the checks for toggles of the partition
+//! (`toggle.rs`), the [`IntegratorOptions`] (`options.rs`), the [`Energy`] book (`energy.rs`)
 //! and the [`DynamicsError`] (`error.rs`).
 
 mod alpha;
 mod control;
 mod energy;
 mod error;
+mod history;
 mod newton;
 mod options;
 mod reduced;
@@ -34,9 +37,11 @@ use nalgebra::{DefaultAllocator, Dim, OVector, U1};
 
 use self::alpha::{Alpha, FreeMotion};
 use self::energy::Book;
+use self::history::History;
 use self::newton::{Failure, IterationMatrix};
 use self::reduced::{Reduced, set_free};
 use self::states::States;
+use self::toggle::Watch;
 use crate::assembly::GUESS_TIME;
 use crate::dynamic::{Dynamic, EquationsOfMotion, FreeStorage};
 #[cfg(doc)]
@@ -83,16 +88,14 @@ where
     matrix: IterationMatrix<M::Free>,
     /// The last Newton correction.
     correction: OVector<f64, M::Free>,
-    /// The free accelerations one step back and that step's size (0: none since the last
-    /// start), for the predictor's extrapolation.
-    earlier: OVector<f64, M::Free>,
-    earlier_step: f64,
+    /// The free accelerations of the last steps, for the predictor's extrapolation.
+    history: History<M::Free>,
     alpha: Alpha,
     options: IntegratorOptions,
     /// The next step's size.
     step: f64,
-    /// `‖V‖` at the last (re)start, against which a toggle's approach is measured.
-    sensitivity: f64,
+    /// The toggle checks' bound on `‖V‖` and per-coordinate floors.
+    watch: Watch<M>,
     book: Book<M>,
     stats: IntegratorStats,
 }
@@ -113,12 +116,11 @@ where
             reduced: self.reduced.clone(),
             matrix: self.matrix.clone(),
             correction: self.correction.clone(),
-            earlier: self.earlier.clone(),
-            earlier_step: self.earlier_step,
+            history: self.history.clone(),
             alpha: self.alpha,
             options: self.options,
             step: self.step,
-            sensitivity: self.sensitivity,
+            watch: self.watch.clone(),
             book: self.book.clone(),
             stats: self.stats,
         }
@@ -192,12 +194,11 @@ where
             reduced: Reduced::new(m, slopes),
             matrix,
             correction: OVector::zeros_generic(f, U1),
-            earlier: OVector::zeros_generic(f, U1),
-            earlier_step: 0.0,
+            history: History::new(f),
             alpha: Alpha::new(options.rho_inf),
             options,
             step,
-            sensitivity: f64::INFINITY,
+            watch: Watch::new(m),
             book: Book::new(m),
             stats: IntegratorStats::default(),
             solver,
@@ -225,9 +226,9 @@ where
         self.matrix.step = None;
         solved.map_err(|failure| self.failure(failure, t, 0.0))?;
         self.next.a.copy_from(&self.next.udd);
-        self.sensitivity = self.reduced.v.norm();
+        self.watch.restart(self.reduced.v.norm());
         self.reduced.accepted.copy_from(&self.reduced.v);
-        self.earlier_step = 0.0;
+        self.history.restart(&self.next.udd);
         self.states.accept();
         core::mem::swap(&mut self.now, &mut self.next);
         let m = self.solver.mechanism();

@@ -21,6 +21,11 @@ use crate::solver::Solver;
 use crate::state::State;
 use crate::structure::Structured;
 
+/// The smallest free rate `|u̇|` from which `V = q̇ / u̇` is taken: far above the range where
+/// the rates `V u̇` would lose digits to underflow (`V`'s entries are the scene's lengths per
+/// unit of `u`, and a rate this small is a state at rest).
+const SMALLEST_RATE: f64 = 1e-150;
+
 /// The evaluation's storage: `V`, `F`, the residual and scratch columns.
 pub(crate) struct Reduced<M: Dynamic>
 where
@@ -130,6 +135,8 @@ where
     /// of q̇ when u̇_k alone changes, divided by the change (one velocity solve each, over the
     /// factors the solve of `state` archived). The change is `1 + |u̇_k|`, so that the
     /// difference keeps the digits of a fast motion. `state` must be the solver's last solve.
+    /// A single free degree of freedom at a state without rheonomic terms needs no solve
+    /// ([`Self::sensitivities_from_rates`]).
     ///
     /// # Errors
     /// A velocity solve's error.
@@ -140,6 +147,9 @@ where
         x: &FreeMotion<M::Free>,
         state: &State<M>,
     ) -> Result<(), SolveError> {
+        if self.sensitivities_from_rates(solver.mechanism(), x, state) {
+            return Ok(());
+        }
         for k in 0..x.u.len() {
             let [u, ud, udd] = x.of(k);
             let change = 1.0 + ud.abs();
@@ -153,6 +163,47 @@ where
             }
         }
         Ok(())
+    }
+
+    /// `V = q̇ / u̇` where that is exact, and whether it was: with one free degree of freedom
+    /// and `ν = −Φ_t` zero on every other row at `state` (no driver of time moving there),
+    /// `q̇ = Φ_q⁻¹ ν` is `V u̇` exactly, and in floating point too, each rate being a sum of
+    /// products with `u̇` (so the quotient keeps the solve's relative precision). Declines
+    /// (leaving `V` to the velocity solve) for a rate at or near zero (from rest), a
+    /// rheonomic row, or a quotient that is not finite.
+    fn sensitivities_from_rates(
+        &mut self,
+        m: &M,
+        x: &FreeMotion<M::Free>,
+        state: &State<M>,
+    ) -> bool {
+        let (Some(&rate), Some(&row)) = (x.ud.get(0), self.rows.get(0)) else {
+            return false;
+        };
+        // NaN fails too.
+        let usable = x.ud.len() == 1 && rate.abs() >= SMALLEST_RATE;
+        if !usable {
+            return false;
+        }
+        m.nu(&state.q, state.t, &mut self.velocity);
+        // The free row's entry cleared (ν is scratch here), every entry must be zero.
+        let Some(free) = self.velocity.get_mut(row) else {
+            return false;
+        };
+        *free = 0.0;
+        let nu = self.velocity.as_slice();
+        if !nu.iter().all(|&nu| nu == 0.0) {
+            return false;
+        }
+        let Some(column) = self.v.as_mut_slice().get_mut(..nu.len()) else {
+            return false;
+        };
+        let inverse = 1.0 / rate;
+        for (v, &qd) in column.iter_mut().zip(state.velocities.as_slice()) {
+            *v = qd * inverse;
+        }
+        // Otherwise the velocity solve overwrites the column.
+        column.iter().all(|v| v.is_finite())
     }
 
     /// Writes `VᵀMV` into `out`.
