@@ -72,9 +72,8 @@ pub(crate) fn set_free<M: Dynamic + Structured>(solver: &mut Solver<M>, x: &Free
 where
     DefaultAllocator: Storage<M::Dim> + FreeStorage<M::Dim, M::Free>,
 {
-    let m = solver.mechanism_mut();
     for k in 0..x.u.len() {
-        m.set_free(k, x.of(k));
+        solver.set_free(k, x.of(k));
     }
 }
 
@@ -111,7 +110,9 @@ where
         state: &mut State<M>,
     ) -> Result<(), SolveError> {
         set_free(solver, x);
-        solver.solve_into(t, state)?;
+        // The state holds the positions of a solve (the last evaluation's or an accepted
+        // state's): a prediction the straight step need not check first.
+        solver.solve_predicted(t, state)?;
         let lambda = solver.multipliers();
         for k in 0..self.residual.len() {
             let row = lambda.get(self.rows[k]).copied().unwrap_or(f64::NAN);
@@ -153,9 +154,9 @@ where
         for k in 0..x.u.len() {
             let [u, ud, udd] = x.of(k);
             let change = 1.0 + ud.abs();
-            solver.mechanism_mut().set_free(k, [u, ud + change, udd]);
+            solver.set_free(k, [u, ud + change, udd]);
             let solved = solver.solve_velocity_again(&state.q, t, &mut self.velocity);
-            solver.mechanism_mut().set_free(k, [u, ud, udd]);
+            solver.set_free(k, [u, ud, udd]);
             solved?;
             let mut column = self.v.column_mut(k);
             for i in 0..column.len() {

@@ -6,6 +6,7 @@ use nalgebra::DefaultAllocator;
 use super::convergence::Convergence;
 use super::sweep::Extras;
 
+use crate::dynamic::{Dynamic, FreeStorage};
 use crate::error::{Described, Quantity, SolveError};
 use crate::mechanism::{Accelerations, LengthScale, Storage, Vector, Velocities};
 use crate::options::{Rates, SolverOptions};
@@ -147,6 +148,17 @@ where
     pub fn mechanism_mut(&mut self) -> &mut M {
         self.checked = false;
         &mut self.mechanism
+    }
+
+    /// Sets free degree of freedom `k`'s state `[u, u̇, ü]` (the integrator's, between its
+    /// solves): it is not a parameter, so the parameters' checks and length scale stand (a
+    /// non-finite state shows as the solve's non-finite coordinate or rate).
+    pub(crate) fn set_free(&mut self, k: usize, state: [f64; 3])
+    where
+        M: Dynamic,
+        DefaultAllocator: FreeStorage<M::Dim, M::Free>,
+    {
+        self.mechanism.set_free(k, state);
     }
 
     /// Gives the mechanism back.
