@@ -86,6 +86,7 @@ where
     /// The other coordinates belong to explicit stages, which assign them whatever their guess:
     /// they are left as `next` holds them when that is a solved state (`history`, finite as the
     /// solve checks), and are `current`'s otherwise.
+    #[inline]
     pub(crate) fn predict(
         &mut self,
         solver: &Solver<M>,
@@ -98,7 +99,8 @@ where
         let h_prev = current.t - next.t;
         let differences = history && h_prev != 0.0 && h_prev.is_finite();
         // Coefficients hoisted out of the loop: one division per step, none per coordinate.
-        let formula = match current.outputs() {
+        // The scene's outputs (its states'), a constant of a generated scene's type.
+        let formula = match solver.mechanism().outputs() {
             Outputs::Positions if !differences => return false,
             Outputs::Positions => Taylor::Secant(h / h_prev),
             Outputs::Velocities if differences => Taylor::Velocities(0.5 * h * h / h_prev),
@@ -139,6 +141,7 @@ where
     /// landed further from the prediction than [`JUMP_FRACTION`] of the predicted motion (plus
     /// the floor), or the prediction turned a block angle by more than
     /// [`MAX_PREDICTED_MOTION`].
+    #[inline]
     pub(crate) fn jumped(&self, solver: &Solver<M>, solved: &Vector<M::Dim>) -> bool {
         if self.turn > MAX_PREDICTED_MOTION {
             return true;
