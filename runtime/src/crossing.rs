@@ -108,7 +108,10 @@ where
     /// configuration to get there.
     fn solve_from_bracket(&mut self, t: f64) -> Result<(u64, bool), SolveError> {
         let (_, next) = pair(&mut self.states, self.newest);
-        if !(self.prediction).predict(&self.solver, &self.bracket, next, false, t) {
+        if !self
+            .prediction
+            .predict(&self.solver, &self.bracket, next, false, t)
+        {
             next.q.copy_from(&self.bracket.q);
         }
         self.has_previous = false;

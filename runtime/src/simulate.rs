@@ -63,7 +63,8 @@ where
     pub(crate) bracket: State<M>,
     /// The last prediction, to measure how far Newton moved from it.
     pub(crate) prediction: Prediction<M>,
-    /// Whether `next` holds a solved earlier state (for the positions-only predictor).
+    /// Whether `next` holds a solved earlier state: the predictor's differences with it, and
+    /// the coordinates of the guess the prediction leaves as they are.
     pub(crate) has_previous: bool,
     predictor: bool,
     max_halvings: u32,
@@ -294,8 +295,10 @@ where
     fn advance(&mut self, t: f64, accept_jump: bool) -> Outcome {
         let (current, next) = pair(&mut self.states, self.newest);
         let history = self.has_previous;
-        let predicted =
-            self.predictor && (self.prediction).predict(&self.solver, current, next, history, t);
+        let predicted = self.predictor
+            && self
+                .prediction
+                .predict(&self.solver, current, next, history, t);
         if !predicted {
             next.q.copy_from(&current.q);
         }
