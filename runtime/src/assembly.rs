@@ -123,7 +123,7 @@ where
                 let (state, previous) = (&self.states[self.newest], &self.states[1 - self.newest]);
                 // Only the blocks' coordinates can lose their branch; a driven angle assigned
                 // in closed form may move as far as it likes.
-                let (motion, ..) = self.solver.block_distances(&previous.q, &state.q, &state.q);
+                let motion = self.solver.block_motion(&previous.q, &state.q);
                 if motion > 0.0 {
                     (STEP_MOTION / motion).clamp(0.5, 2.0)
                 } else {

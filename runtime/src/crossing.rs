@@ -26,7 +26,7 @@ use nalgebra::DefaultAllocator;
 
 use crate::error::SolveError;
 use crate::mechanism::Storage;
-use crate::simulate::{Simulation, pair, predict};
+use crate::simulate::{Simulation, pair};
 use crate::structure::Structured;
 
 /// Where a solution lies relative to the crossing being located.
@@ -108,8 +108,10 @@ where
     /// configuration to get there.
     fn solve_from_bracket(&mut self, t: f64) -> Result<(u64, bool), SolveError> {
         let (_, next) = pair(&mut self.states, self.newest);
-        let m = self.solver.mechanism();
-        if !predict(m, &self.bracket, next, false, t, &mut self.prediction) {
+        if !self
+            .prediction
+            .predict(&self.solver, &self.bracket, next, false, t)
+        {
             next.q.copy_from(&self.bracket.q);
         }
         self.has_previous = false;

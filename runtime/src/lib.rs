@@ -83,6 +83,7 @@ mod options;
 mod origin;
 mod physics;
 mod position;
+mod prediction;
 mod reactions;
 mod simulate;
 mod solver;

@@ -6,30 +6,12 @@
 use nalgebra::DefaultAllocator;
 
 use crate::error::{Quantity, SolveError};
-use crate::mechanism::{Outputs, Storage, Vector};
+use crate::mechanism::Storage;
+use crate::prediction::Prediction;
 use crate::solver::Solver;
 use crate::state::State;
-use crate::structure::{Stage, Structured};
+use crate::structure::Structured;
 
-/// A predicted step is suspect when Newton moved the solution further from the prediction than
-/// this fraction of the predicted motion (both measured on the Newton blocks' coordinates, the
-/// only ones a solve can move to another branch): a second-order prediction is O(h³) off while the
-/// motion is O(h), so only a step far too coarse for the motion, or a landing on the mirror
-/// branch, gets near it.
-const JUMP_FRACTION: f64 = 0.5;
-/// … plus this much (scaled: scene lengths, radians) and ten times the solver's tolerances, so
-/// that a mechanism at rest, whose predicted motion is zero, is not suspect for the corrections
-/// of round-off or of a loosely converged solve.
-const JUMP_FLOOR: f64 = 1e-6;
-/// A predicted step is also suspect when the prediction turns a block angle by more than this
-/// (radians), however close Newton lands to it: over so long a step the Taylor prediction
-/// says nothing about which turn of a lever or which side of a crank the motion reaches, so a
-/// solution near it may be another winding of the same pose (a single step of 20 rad of crank
-/// gave a lever four turns ahead). It is the solver's default step clamp: no single Newton
-/// step moves further either. Lengths are not bounded: a tall linkage's upper bodies travel
-/// many scene lengths in a step while each joint turns a little (the 1000-stage scissor
-/// lift's platform), and bounding them sub-stepped its rise in proportion to its height.
-const MAX_PREDICTED_MOTION: f64 = 1.0;
 /// Default number of times a failed step may be halved; see [`Simulation::set_max_halvings`].
 pub const DEFAULT_MAX_HALVINGS: u32 = 10;
 
@@ -80,8 +62,9 @@ where
     /// The latest solution before a singular crossing, while the crossing is located.
     pub(crate) bracket: State<M>,
     /// The last prediction, to measure how far Newton moved from it.
-    pub(crate) prediction: Vector<M::Dim>,
-    /// Whether `next` holds a solved earlier state (for the positions-only predictor).
+    pub(crate) prediction: Prediction<M>,
+    /// Whether `next` holds a solved earlier state: the predictor's differences with it, and
+    /// the coordinates of the guess the prediction leaves as they are.
     pub(crate) has_previous: bool,
     predictor: bool,
     max_halvings: u32,
@@ -128,7 +111,7 @@ where
         Self {
             saved: current.clone(),
             bracket: current.clone(),
-            prediction: current.q.clone(),
+            prediction: Prediction::new(&current),
             states: [current.clone(), current],
             newest: 0,
             solver,
@@ -184,9 +167,8 @@ where
     /// serve the rates).
     ///
     /// When that solve fails in a way a shorter step may cure (no convergence, no assembly, a
-    /// branch flip, a singular solution), predicts a motion of more than a scene length or a
-    /// radian of a block's coordinates, or lands suspiciously far from the prediction (the
-    /// mirror branch), the
+    /// branch flip, a singular solution), predicts a turn of more than a radian of a block's
+    /// angle, or lands suspiciously far from the prediction (the mirror branch), the
     /// drivers are sub-stepped: the interval is halved, and halved again on failure, down to
     /// 2^-`max_halvings` of it, each sub-step predicted from the last. The state then records the
     /// sub-steps taken ([`State::substeps`]) and all their Newton iterations, evaluations and
@@ -306,15 +288,17 @@ where
 
     /// One predicted solve at `t` into `next`; on success `next` becomes `current`, except for
     /// a suspected jump, which is left unaccepted unless `accept_jump`.
-    // Inlined: the usual step is one `advance`, and its large `Outcome` is then not moved
-    // through memory (30 instructions of a seed step's ~4,500).
-    #[inline]
+    // Always inlined: the usual step is one `advance`, and its large `Outcome` is then not
+    // moved through memory, nor its call made (~20 instructions of the seed's ~1,200 a step,
+    // which a plain `#[inline]` left out once the prediction moved to its own module).
+    #[inline(always)]
     fn advance(&mut self, t: f64, accept_jump: bool) -> Outcome {
         let (current, next) = pair(&mut self.states, self.newest);
-        let m = self.solver.mechanism();
         let history = self.has_previous;
-        let predicted =
-            self.predictor && predict(m, current, next, history, t, &mut self.prediction);
+        let predicted = self.predictor
+            && self
+                .prediction
+                .predict(&self.solver, current, next, history, t);
         if !predicted {
             next.q.copy_from(&current.q);
         }
@@ -323,15 +307,8 @@ where
         if let Err(error) = self.solver.solve_predicted(t, next) {
             return Outcome::Failed(error);
         }
-        if predicted && !accept_jump {
-            let (motion, correction, turn) =
-                self.solver
-                    .block_distances(&current.q, &self.prediction, &next.q);
-            let options = self.solver.options();
-            let floor = JUMP_FLOOR + 10.0 * (options.residual_tolerance + options.step_tolerance);
-            if correction > JUMP_FRACTION * motion + floor || turn > MAX_PREDICTED_MOTION {
-                return Outcome::Jumped;
-            }
+        if predicted && !accept_jump && self.prediction.jumped(&self.solver, &next.q) {
+            return Outcome::Jumped;
         }
         if next.block_signs != current.block_signs || next.swept {
             return Outcome::Crossed;
@@ -380,103 +357,6 @@ fn retryable(error: &SolveError) -> bool {
 pub(crate) fn pair<T>(states: &mut [T; 2], newest: usize) -> (&T, &mut T) {
     let [a, b] = states;
     if newest == 0 { (a, b) } else { (b, a) }
-}
-
-/// Writes the guess at `t` into `guess` and `next.q` and says whether it did (otherwise
-/// neither is touched): `current`'s positions, with the Newton blocks' coordinates predicted
-/// by the Taylor expansion from `current` with the derivatives the scene computes, plus one
-/// more from the difference with the previous state, which `next` still holds when `history`
-/// (the secant slope for positions-only scenes, q̈ from two velocities, the jerk from two
-/// accelerations). A positions-only scene without history has nothing to predict with.
-///
-/// Only the blocks' coordinates are predicted: they are the ones a solve starts Newton from,
-/// while every other coordinate belongs to an explicit stage, which assigns it whatever its
-/// guess (and `current`'s value keeps the guess finite, as the solve checks).
-pub(crate) fn predict<M: Structured>(
-    m: &M,
-    current: &State<M>,
-    next: &mut State<M>,
-    history: bool,
-    t: f64,
-    guess: &mut Vector<M::Dim>,
-) -> bool
-where
-    DefaultAllocator: Storage<M::Dim>,
-{
-    let h = t - current.t;
-    let h_prev = current.t - next.t;
-    let history = history && h_prev != 0.0 && h_prev.is_finite();
-    // Coefficients hoisted out of the loop: one division per step, none per coordinate.
-    let formula = match current.outputs() {
-        Outputs::Positions if !history => return false,
-        Outputs::Positions => Taylor::Secant(h / h_prev),
-        Outputs::Velocities if history => Taylor::Velocities(0.5 * h * h / h_prev),
-        Outputs::Velocities => Taylor::Velocity,
-        Outputs::Accelerations | Outputs::Forces if history => {
-            Taylor::Accelerations(h * h * h / (6.0 * h_prev))
-        }
-        Outputs::Accelerations | Outputs::Forces => Taylor::Acceleration,
-    };
-    let now = [&current.q, &current.velocities, &current.accelerations].map(|v| v.as_slice());
-    let before = [&next.q, &next.velocities, &next.accelerations].map(|v| v.as_slice());
-    guess.copy_from(&current.q);
-    let guess_slice = guess.as_mut_slice();
-    for s in 0..m.stage_count() {
-        let Some(Stage::Block(block)) = m.stage(s) else {
-            continue;
-        };
-        for &j in block.coordinates {
-            let (Some(g), Some(value)) = (guess_slice.get_mut(j), formula.at(j, h, now, before))
-            else {
-                continue;
-            };
-            *g = value;
-        }
-    }
-    next.q.copy_from(guess);
-    true
-}
-
-/// The Taylor formula of a prediction, by what the scene computes and whether the previous
-/// state is known, with its coefficient of the difference with that state.
-#[derive(Clone, Copy)]
-enum Taylor {
-    /// Positions only: the secant through the last two, `q + (q − q_prev) h / h_prev`.
-    Secant(f64),
-    /// `q + q̇ h`.
-    Velocity,
-    /// … `+ ½ q̈ h²`, q̈ from the last two velocities (the coefficient `h² / (2 h_prev)`).
-    Velocities(f64),
-    /// `q + q̇ h + ½ q̈ h²`.
-    Acceleration,
-    /// … `+ ⅙ q⃛ h³`, q⃛ from the last two accelerations (the coefficient `h³ / (6 h_prev)`).
-    Accelerations(f64),
-}
-
-impl Taylor {
-    /// The prediction of coordinate `j` over a step `h` from the (q, q̇, q̈) `now`, with the
-    /// previous state's `before`; `None` past the end. A term is left out, not multiplied by
-    /// zero, where the state has no such value (`before` may hold a failed solve's non-finite
-    /// iterate).
-    #[inline]
-    fn at(self, j: usize, h: f64, now: [&[f64]; 3], before: [&[f64]; 3]) -> Option<f64> {
-        let [q, qd, qdd] = now.map(|v| v.get(j).copied());
-        let [q_prev, qd_prev, qdd_prev] = before.map(|v| v.get(j).copied());
-        let q = q?;
-        Some(match self {
-            Taylor::Secant(ratio) => q + (q - q_prev?) * ratio,
-            Taylor::Velocity => q + h * qd?,
-            Taylor::Velocities(c) => {
-                let v = qd?;
-                q + h * v + c * (v - qd_prev?)
-            }
-            Taylor::Acceleration => q + h * qd? + 0.5 * h * h * qdd?,
-            Taylor::Accelerations(c) => {
-                let a = qdd?;
-                q + h * qd? + 0.5 * h * h * a + c * (a - qdd_prev?)
-            }
-        })
-    }
 }
 
 /// The k-th of `steps` equal steps from `t0` to `t_end`: `t0 + k·h` with

@@ -22,3 +22,4 @@ mod sweep;
 
 pub use api::Solver;
 pub use convergence::Convergence;
+pub(crate) use scale::larger;

@@ -18,44 +18,35 @@ where
         self.distance_over(a, b, 0..a.len().min(b.len()))
     }
 
-    /// [`Solver::scaled_distance`] from `prediction` to `previous` and to `solved` (the
-    /// motion predicted and the correction Newton made), over the coordinates of the Newton
-    /// blocks only: those on which a solve can choose a branch (explicit assignments have one
-    /// solution), so where a jump to another branch shows; and the largest predicted turn of
-    /// a block angle (radians).
-    pub(crate) fn block_distances(
-        &self,
-        previous: &Vector<M::Dim>,
-        prediction: &Vector<M::Dim>,
-        solved: &Vector<M::Dim>,
-    ) -> (f64, f64, f64) {
+    /// How far `solved` moved from `previous` on the coordinates of the Newton blocks only
+    /// ([`Solver::scaled_distance`] over them): those on which a solve can choose a branch
+    /// (explicit assignments have one solution), so where a jump to another branch shows.
+    pub(crate) fn block_motion(&self, previous: &Vector<M::Dim>, solved: &Vector<M::Dim>) -> f64 {
+        let (previous, solved) = (previous.as_slice(), solved.as_slice());
+        let mut motion = 0.0;
+        self.visit_block_coordinates(|j, inverse_scale, _| {
+            if let (Some(p), Some(s)) = (previous.get(j), solved.get(j)) {
+                motion = larger(motion, ((s - p) * inverse_scale).abs());
+            }
+        });
+        motion
+    }
+
+    /// Calls `visit(j, L⁻ᵖ, angle)` for each coordinate `j` of the Newton blocks, in solve
+    /// order, with the factor that measures it in scene lengths or radians (at the length scale
+    /// of the last solve) and whether it is an angle.
+    #[inline]
+    pub(crate) fn visit_block_coordinates(&self, mut visit: impl FnMut(usize, f64, bool)) {
         let m = &self.mechanism;
-        let (previous, prediction, solved) = (
-            previous.as_slice(),
-            prediction.as_slice(),
-            solved.as_slice(),
-        );
-        let (mut motion, mut correction, mut turn) = (0.0, 0.0, 0.0);
         for s in 0..m.stage_count() {
             let Some(Stage::Block(block)) = m.stage(s) else {
                 continue;
             };
             for &j in block.coordinates {
-                let (Some(x), Some(p), Some(s)) =
-                    (prediction.get(j), previous.get(j), solved.get(j))
-                else {
-                    continue;
-                };
                 let unit = m.coordinate_unit(j);
-                let moved = ((x - p) * self.length.inverse_of(unit)).abs();
-                motion = larger(motion, moved);
-                if unit == Unit::Angle {
-                    turn = larger(turn, moved);
-                }
-                correction = larger(correction, ((x - s) * self.length.inverse_of(unit)).abs());
+                visit(j, self.length.inverse_of(unit), unit == Unit::Angle);
             }
         }
-        (motion, correction, turn)
     }
 
     fn distance_over(
@@ -102,7 +93,7 @@ fn power_of_two(length: f64) -> f64 {
 }
 
 /// The larger of two distances, NaN winning.
-fn larger(largest: f64, d: f64) -> f64 {
+pub(crate) fn larger(largest: f64, d: f64) -> f64 {
     if d > largest || d.is_nan() {
         d
     } else {
