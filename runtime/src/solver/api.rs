@@ -67,13 +67,12 @@ where
     /// `position` module's escape): [`crate::Simulation::new`] tries the other side when the
     /// first leads off a declared branch.
     pub(crate) escape_side: f64,
-    /// The closed-form candidates the last straight step took (its
-    /// [`crate::step::StepReport`]'s `choices`): the next one tries them first.
-    pub(super) closed_choices: u64,
     /// Whether the parameters passed their checks and gave the length scale since the
     /// mechanism or the options last changed ([`Solver::check_mechanism`]).
     pub(super) checked: bool,
-    /// The straight step's settings at the length scale, made with the check.
+    /// The straight step's settings at the length scale, made with the check, and the
+    /// closed-form candidates the last straight step took (its
+    /// [`crate::step::StepReport`]'s `choices`), which the next one tries first.
     pub(super) context: StepContext,
     /// Whether the force solve's archive holds the block factors, and the trig cache the
     /// sines and cosines, at the positions of the last solve (a full solve of a scene that
@@ -105,7 +104,6 @@ where
             length: self.length,
             diagnosed: self.diagnosed,
             escape_side: self.escape_side,
-            closed_choices: self.closed_choices,
             checked: self.checked,
             context: self.context,
             factors_archived: self.factors_archived,
@@ -131,7 +129,6 @@ where
             length: LengthScale::new(1.0),
             diagnosed: (0, 0),
             escape_side: 1.0,
-            closed_choices: 0,
             checked: false,
             context: StepContext::new(&options, LengthScale::new(1.0), 0),
             factors_archived: false,

@@ -24,7 +24,7 @@ where
         if !self.checked {
             self.check_parameters(t)?;
             self.update_scale();
-            self.context = StepContext::new(&self.options, self.length, 0);
+            self.context = StepContext::new(&self.options, self.length, self.context.choices);
             self.checked = true;
         }
         Ok(())

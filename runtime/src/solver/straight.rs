@@ -15,7 +15,7 @@ use crate::options::Rates;
 use crate::state::State;
 use crate::step::{StepContext, StepReport};
 use crate::structure::Structured;
-use crate::workspace::Workspace;
+use crate::workspace::{StepParts, Workspace};
 
 impl<M: Structured> Solver<M>
 where
@@ -49,30 +49,31 @@ where
             Guess::Predicted => {}
         }
         self.check_mechanism(t)?;
-        let context = StepContext {
-            choices: self.closed_choices,
-            ..self.context
-        };
+        let Self {
+            mechanism: m,
+            workspace,
+            context,
+            ..
+        } = self;
         let mut report = StepReport::new(context.estimate_condition);
+        let parts = workspace.step_parts();
         let done = if rates == Rates::Forces {
-            self.straight_forces(t, state, &context, &mut report)
+            straight_forces(m, parts, t, state, context, &mut report)
         } else {
-            let trig = self.workspace.step_parts().trig;
             let (q, qd, qdd) = (
                 &mut state.q,
                 &mut state.velocities,
                 &mut state.accelerations,
             );
-            let m = &self.mechanism;
-            m.straight_step(t, q, qd, qdd, trig, &mut [], &context, &mut report)
+            m.straight_step(t, q, qd, qdd, parts.trig, &mut [], context, &mut report)
                 .is_ok()
-                && markers(m, t, state, trig)
+                && markers(m, t, state, parts.trig)
         };
         if !done {
             return Ok(None);
         }
+        context.choices = report.choices;
         self.diagnosed = (0, 0);
-        self.closed_choices = report.choices;
         Ok(Some(Convergence {
             iterations: 0,
             residual: report.residual,
@@ -85,38 +86,39 @@ where
             closed_forms: report.blocks,
         }))
     }
+}
 
-    /// The straight step of a scene that computes forces: the step, which also archives
-    /// every block's factors as the sweep archives them (for the integrator's velocity solves
-    /// over them) and ends with the force solve's multipliers, then the reactions and the
-    /// markers; whether all of it succeeded (non-finite reactions leave the sweep to name
-    /// their cause).
-    fn straight_forces(
-        &mut self,
-        t: f64,
-        state: &mut State<M>,
-        context: &StepContext,
-        report: &mut StepReport,
-    ) -> bool {
-        let m = &self.mechanism;
-        let parts = self.workspace.step_parts();
-        let (q, qd, qdd) = (
-            &mut state.q,
-            &mut state.velocities,
-            &mut state.accelerations,
-        );
-        let forces = &mut *parts.forces;
-        if m.straight_step(t, q, qd, qdd, parts.trig, forces, context, report)
-            .is_err()
-        {
-            return false;
-        }
-        // Every block of a straight step is factored with its static pivots.
-        parts.archived.fill(true);
-        let lambda = parts.forces.get(..q.len()).unwrap_or_default();
-        m.reactions(q, qd, lambda, &mut state.reactions);
-        all_finite(state.reactions.as_slice()) && markers(m, t, state, parts.trig)
+/// The straight step of a scene that computes forces: the step, which also archives every
+/// block's factors as the sweep archives them (for the integrator's velocity solves over
+/// them) and ends with the force solve's multipliers, then the reactions and the markers;
+/// whether all of it succeeded (non-finite reactions leave the sweep to name their cause).
+fn straight_forces<M: Structured>(
+    m: &M,
+    parts: StepParts<'_>,
+    t: f64,
+    state: &mut State<M>,
+    context: &StepContext,
+    report: &mut StepReport,
+) -> bool
+where
+    DefaultAllocator: Storage<M::Dim>,
+{
+    let (q, qd, qdd) = (
+        &mut state.q,
+        &mut state.velocities,
+        &mut state.accelerations,
+    );
+    let forces = &mut *parts.forces;
+    if m.straight_step(t, q, qd, qdd, parts.trig, forces, context, report)
+        .is_err()
+    {
+        return false;
     }
+    // Every block of a straight step is factored with its static pivots.
+    parts.archived.fill(true);
+    let lambda = parts.forces.get(..q.len()).unwrap_or_default();
+    m.reactions(q, qd, lambda, &mut state.reactions);
+    all_finite(state.reactions.as_slice()) && markers(m, t, state, parts.trig)
 }
 
 /// The markers at the step's solved state, which the step's own end checks leave out;
