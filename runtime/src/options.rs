@@ -98,11 +98,12 @@ pub struct SolverOptions {
     /// nearest the guess (default true); Newton then verifies it. Off, Newton starts from the
     /// guess itself: only for comparing the two paths.
     pub closed_forms: bool,
-    /// Solve a scene that has a straight kinematic step (`Structured::straight_step`: every
-    /// block with a closed form, no forces) by it when `closed_forms` is on too (default
-    /// true): the stages in one generated function, each block taking its closed-form
-    /// solution under the checks Newton's first iteration would make; where one fails, the
-    /// stage sweep runs. Off, the sweep always runs: only for comparing the two paths.
+    /// Solve a scene that has a straight step (`Structured::straight_step`: every block with
+    /// a closed form, the accelerations or the forces asked for) by it when `closed_forms`
+    /// and `static_pivots` are on too (default true): the stages in one generated function,
+    /// each block taking its closed-form solution under the checks Newton's first iteration
+    /// would make, then, with forces, the force solve; where one fails, the stage sweep runs.
+    /// Off, the sweep always runs: only for comparing the two paths.
     pub straight_step: bool,
 }
 

@@ -1,7 +1,8 @@
 //! What a scene's straight kinematic step ([`crate::Structured::straight_step`]) calls: the
 //! solver's settings it checks against ([`StepContext`]), what it reports back
 //! ([`StepReport`]), and the safeguards of a closed-form block, each the same rule the
-//! stage sweep applies to that block's Newton start.
+//! stage sweep applies to that block's Newton start; for a scene that computes forces, the
+//! transposed solve of its force solve ([`StepContext::multipliers`]).
 //!
 //! The generated step runs every stage in the sweep's order with the scene's kernels called
 //! directly. A block takes its closed-form solution nearest the guess
