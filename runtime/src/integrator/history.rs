@@ -10,7 +10,7 @@
 //! the values kept are the accepted accelerations plus the Newton correction their step still
 //! called for (not applied: the step was accepted without it), which is what brings the
 //! free seed to one evaluation per step (with the bare accelerations, 1.7).
-//!
+
 use nalgebra::{DefaultAllocator, Dim, OVector, U1};
 
 use crate::mechanism::Storage;
