@@ -11,7 +11,9 @@
 //! factors its Newton iteration ended with, which the forward sweep archived ([`archive`]). A
 //! block without archived factors (partial pivoting after a static pivot failed, or the dense
 //! reference) is factored once more at the solution. The multipliers then become the reported
-//! reactions ([`crate::Mechanism::reactions`]).
+//! reactions ([`crate::Mechanism::reactions`]). This is the stage sweep's force solve; a scene
+//! with a straight step runs the same passes as its generated code, over an archive of the
+//! same layout ([`Structured::straight_step`]).
 
 use nalgebra::DefaultAllocator;
 
