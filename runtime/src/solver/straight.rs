@@ -24,9 +24,10 @@ where
     /// Solves `state` at `t` by the straight step: `Ok(Some(convergence))` when it did,
     /// `Ok(None)` when the stage sweep must (no straight step; it, closed forms or static
     /// pivots switched off; fewer rates than both asked for; a check declined, or the
-    /// reactions are not finite). The guess is then as it was, or, past a declined end check, the step's
-    /// positions, from which every block takes the same closed-form solution (non-finite
-    /// markers or multipliers, which the sweep reports from the same positions).
+    /// reactions are not finite). The guess is then as it was, or, past a declined end
+    /// check, the step's positions, from which every block takes the same closed-form
+    /// solution (non-finite markers or reactions, which the sweep reports from the same
+    /// positions).
     ///
     /// # Errors
     /// The sweep's input checks: a non-finite `t` or, when [`Guess::Given`], guess; an invalid
