@@ -96,16 +96,7 @@ impl Stages {
         let forces = unused(self.forces.is_some(), "forces");
         let (storage, force_solve) = self.forces.as_ref().map(|f| (&f.storage, &f.call)).unzip();
         let force_function = self.forces.as_ref().map(|f| &f.function);
-        let trig_len = idx(kernels.sizes.trig);
-        let view = reads("trig").then(|| {
-            quote! {
-                let ::core::option::Option::Some(trig) =
-                    trig_cache.first_chunk_mut::<#trig_len>()
-                else {
-                    return ::core::result::Result::Err(0);
-                };
-            }
-        });
+        let view = reads("trig").then(|| trig_view(kernels, true));
         let vector = cx.vector_type();
         let (stages, variants) = (&self.code, &self.variants);
         let EndChecks {
@@ -220,6 +211,22 @@ fn trait_method() -> TokenStream {
             }
             result
         }
+    }
+}
+
+/// `trig`: the trig cache `trig_cache` viewed as the array the kernels take, `mutable` where
+/// the stages fill it.
+pub(super) fn trig_view(kernels: &Kernels, mutable: bool) -> TokenStream {
+    let trig_len = idx(kernels.sizes.trig);
+    let chunk = if mutable {
+        quote!(first_chunk_mut)
+    } else {
+        quote!(first_chunk)
+    };
+    quote! {
+        let ::core::option::Option::Some(trig) = trig_cache.#chunk::<#trig_len>() else {
+            return ::core::result::Result::Err(0);
+        };
     }
 }
 

@@ -17,7 +17,7 @@ use quote::{format_ident, quote};
 use super::body::Context;
 use super::idx;
 use super::plan::Kernel;
-use super::step::{StageCalls, block_scales, unused};
+use super::step::{StageCalls, block_scales, trig_view, unused};
 use crate::plan::kernels::{Kernels, Method};
 
 /// Where each stage's factors go in the force solve's archive (after the multipliers): a
@@ -57,7 +57,7 @@ pub(super) fn straight_forces(
         .map(|(name, ty)| (format_ident!("{}", name), ty))
         .collect();
     // The trig cache is viewed as its array again: the step's end checks read it whole.
-    let (trig_cache, view) = trig_view(kernels, reads("trig"));
+    let (trig_cache, view) = trig_parameter(kernels, reads("trig"));
     let (archive, context) = (unused(blocks, "archive"), unused(blocks, "context"));
     let (dim, archived): (Literal, Literal) = (
         idx(cx.model.dim()),
@@ -134,7 +134,7 @@ pub(super) fn straight_velocities(
         idx(cx.model.dim()),
         idx(ranges.iter().flatten().map(|r| r.len()).sum()),
     );
-    let (trig_cache, view) = trig_view(kernels, reads("trig"));
+    let (trig_cache, view) = trig_parameter(kernels, reads("trig"));
     let archive = blocks.then(|| {
         quote! {
             let ::core::option::Option::Some(archive) =
@@ -241,17 +241,12 @@ impl Pass {
 
 /// The trig cache parameter of a pass's function (`_trig_cache` where no kernel reads it,
 /// `used`) and its view as the array the kernels take.
-fn trig_view(kernels: &Kernels, used: bool) -> (Ident, TokenStream) {
-    if !used {
-        return (format_ident!("_trig_cache"), TokenStream::new());
+fn trig_parameter(kernels: &Kernels, used: bool) -> (Ident, TokenStream) {
+    if used {
+        (format_ident!("trig_cache"), trig_view(kernels, false))
+    } else {
+        (format_ident!("_trig_cache"), TokenStream::new())
     }
-    let trig_len = idx(kernels.sizes.trig);
-    let view = quote! {
-        let ::core::option::Option::Some(trig) = trig_cache.first_chunk::<#trig_len>() else {
-            return ::core::result::Result::Err(0);
-        };
-    };
-    (format_ident!("trig_cache"), view)
 }
 
 /// The functions of the kernels of `methods`.

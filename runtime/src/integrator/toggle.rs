@@ -17,8 +17,8 @@
 //!   reflection, whatever the step. The step fails when the part of `d` that the free
 //!   coordinates' own motion does not explain exceeds [`KINK`] times the scale
 //!   `½(|q̇_n| + |q̇_{n+1}|) + ½h(|q̈_n| + |q̈_{n+1}|)`, rates that would move the coordinate
-//!   by less than a millionth of its scale over the step counting as zero (measured: 1.3–2.0 across the
-//!   pendulum's reflection; at most 0.013 on every resolved motion of the tests). The
+//!   by less than a millionth of its scale over the step counting as zero (measured: 1.3–2.0
+//!   across the pendulum's reflection; at most 0.013 on every resolved motion of the tests). The
 //!   free motion explains the defect of `u` itself carried by `V` (large at ρ∞ < 1 for an
 //!   unresolved stiff mode, whose `u̇` and `ü` alternate while the method's acceleration is
 //!   smooth) and `V`'s change against the jump of `ü`. One more part, the jump of the
